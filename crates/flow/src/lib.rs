@@ -1,0 +1,1 @@
+//! Particle-fluid forces, flow fields, Lagrangian tracker and deposition.

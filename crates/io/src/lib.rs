@@ -1,0 +1,1 @@
+//! Run folders, VTU/PVD, CSV time series, checkpoints and plots.

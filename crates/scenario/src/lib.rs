@@ -1,0 +1,1 @@
+//! Scenario files: TOML schemas, validation with located errors, conversion into workflow inputs.

@@ -1,0 +1,1 @@
+//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
