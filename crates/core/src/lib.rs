@@ -10,7 +10,8 @@
 //! * [`control`] — how a long run learns it should stop and reports progress;
 //! * [`rng`] — seeded, serialisable random number generators;
 //! * [`check`] — physical validation of inputs with the key path of every bad value;
-//! * [`regime`] — the stick/bounce wall rule (regime-map JSON) shared by the snow workflow and trackers.
+//! * [`regime`] — the stick/bounce wall rule (regime-map JSON) shared by the snow workflow and trackers;
+//! * [`validation`] — the case/check format of `spatter validate`.
 //!
 //! Everything is in SI units. The core knows nothing of the engines built on it.
 
@@ -26,6 +27,7 @@ pub mod motion;
 pub mod regime;
 pub mod rng;
 pub mod timestep;
+pub mod validation;
 
 pub use aabb::Aabb;
 pub use math::{Mat3, Quat, Vec3};

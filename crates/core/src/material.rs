@@ -13,14 +13,36 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Isotropic elastic material.
+///
+/// In scenario files the keys carry their units: `youngs_modulus_pa`, `poisson_ratio`, `density_kg_m3`
+/// (`youngs_modulus_pa = inf` makes a rigid body).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Material {
     /// Young's modulus E \[Pa\]; `f64::INFINITY` for a rigid body.
+    #[serde(rename = "youngs_modulus_pa")]
     pub youngs_modulus: f64,
     /// Poisson ratio ν \[-\], in \[0, 0.5).
     pub poisson_ratio: f64,
     /// Density ρ \[kg/m³\].
+    #[serde(rename = "density_kg_m3")]
     pub density: f64,
+}
+
+impl crate::check::Validate for Material {
+    fn validate(&self, c: &mut crate::check::Checker) {
+        if self.youngs_modulus.is_nan() || self.youngs_modulus <= 0.0 {
+            c.fail(
+                "youngs_modulus_pa",
+                format!(
+                    "youngs_modulus_pa = {} must be a positive number of pascals (inf for a rigid body)",
+                    self.youngs_modulus
+                ),
+            );
+        }
+        c.in_range("poisson_ratio", self.poisson_ratio, 0.0, true, 0.5, false);
+        c.positive("density_kg_m3", self.density);
+    }
 }
 
 /// A material value outside its physical range.
