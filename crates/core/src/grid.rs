@@ -34,7 +34,7 @@ impl CellGrid {
         assert!(cell_size > 0.0 && cell_size.is_finite(), "cell size must be positive, got {cell_size}");
         let n = points.len();
         let bounds = if n > 50_000 {
-            points.par_chunks(8192).map(|c| Aabb::from_points(c)).reduce(|| Aabb::EMPTY, Aabb::union)
+            points.par_chunks(8192).map(Aabb::from_points).reduce(|| Aabb::EMPTY, Aabb::union)
         } else {
             Aabb::from_points(points)
         };

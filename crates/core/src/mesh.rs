@@ -353,7 +353,7 @@ impl TriMesh {
 
     /// Whether `p` lies inside a closed mesh (parity of crossings of a ray along a slightly skewed axis).
     pub fn contains_point(&self, p: Vec3) -> bool {
-        let dir = Vec3::new(0.5773502691896258, 0.5773502691896257, 0.5773502691896259)
+        let dir = Vec3::new(0.577_350_269_189_625_8, 0.577_350_269_189_625_7, 0.577_350_269_189_626)
             + Vec3::new(1.3e-7, -2.9e-7, 0.0);
         let mut crossings = 0u32;
         for t in 0..self.triangles.len() {

@@ -1,1 +1,38 @@
-//! Run folders, VTU/PVD, CSV time series, checkpoints and plots.
+//! `spatter-io`: what a run leaves on disk.
+//!
+//! * [`run`] — the run folder, the context a job runs in and the summary it returns;
+//! * [`csv`] — time series with units in the header, resumable after a checkpoint;
+//! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
+//! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
+//! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
+//! * [`plot`] — PNG/SVG charts and mesh colour maps.
+
+pub mod checkpoint;
+pub mod csv;
+pub mod plot;
+pub mod pvd;
+pub mod run;
+pub mod vtu;
+
+/// Formats `x` so that it parses back to the same `f64` (shortest round-trip form), in exponent notation
+/// for very large or small magnitudes.
+pub fn fmt_f64(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || (1e-4..1e15).contains(&a) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn float_formatting_round_trips() {
+        for x in [0.0, 1.0, -2.5, 1e-20, 6.02214076e23, 0.1, 1.0 / 3.0, 123456.789, f64::MIN_POSITIVE] {
+            let s = super::fmt_f64(x);
+            assert_eq!(s.parse::<f64>().unwrap(), x, "{s}");
+        }
+        assert_eq!(super::fmt_f64(1e-20), "1e-20");
+    }
+}

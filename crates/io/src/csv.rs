@@ -1,0 +1,165 @@
+//! CSV output. Column names carry their units (`t_s`, `ke_J`, `force_N`); values are written in a form
+//! that parses back to the identical `f64`.
+
+use crate::fmt_f64;
+use std::fs::{File, OpenOptions};
+use std::io::{self, BufWriter, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+
+/// A numeric time series written row by row. Resumable: a checkpoint stores [`CsvSeries::bytes_written`]
+/// and [`CsvSeries::resume`] cuts the file back to that length before appending, so an interrupted and
+/// resumed run leaves the same file as an uninterrupted one.
+pub struct CsvSeries {
+    path: PathBuf,
+    out: BufWriter<File>,
+    columns: usize,
+    bytes: u64,
+}
+
+fn with_path(e: io::Error, path: &Path) -> io::Error {
+    io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+}
+
+impl CsvSeries {
+    /// Creates (or truncates) `path` and writes the header line.
+    pub fn create(path: &Path, columns: &[&str]) -> io::Result<Self> {
+        let file = File::create(path).map_err(|e| with_path(e, path))?;
+        let mut s =
+            CsvSeries { path: path.to_owned(), out: BufWriter::new(file), columns: columns.len(), bytes: 0 };
+        let header = columns.join(",") + "\n";
+        s.write_raw(header.as_bytes())?;
+        Ok(s)
+    }
+
+    /// Reopens `path` after a checkpoint: keeps its first `byte_len` bytes and appends after them.
+    pub fn resume(path: &Path, columns: &[&str], byte_len: u64) -> io::Result<Self> {
+        let mut file =
+            OpenOptions::new().read(true).write(true).open(path).map_err(|e| with_path(e, path))?;
+        let len = file.metadata()?.len();
+        if len < byte_len {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{} is shorter ({len} B) than its checkpoint says ({byte_len} B)", path.display()),
+            ));
+        }
+        file.set_len(byte_len)?;
+        file.seek(SeekFrom::Start(byte_len))?;
+        Ok(CsvSeries {
+            path: path.to_owned(),
+            out: BufWriter::new(file),
+            columns: columns.len(),
+            bytes: byte_len,
+        })
+    }
+
+    fn write_raw(&mut self, b: &[u8]) -> io::Result<()> {
+        self.out.write_all(b).map_err(|e| with_path(e, &self.path))?;
+        self.bytes += b.len() as u64;
+        Ok(())
+    }
+
+    /// Appends one row; the number of values must match the header.
+    pub fn row(&mut self, values: &[f64]) -> io::Result<()> {
+        if values.len() != self.columns {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "{}: row has {} values, header has {}",
+                    self.path.display(),
+                    values.len(),
+                    self.columns
+                ),
+            ));
+        }
+        let mut line = String::with_capacity(16 * values.len());
+        for (i, v) in values.iter().enumerate() {
+            if i > 0 {
+                line.push(',');
+            }
+            line.push_str(&fmt_f64(*v));
+        }
+        line.push('\n');
+        self.write_raw(line.as_bytes())
+    }
+
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush().map_err(|e| with_path(e, &self.path))
+    }
+
+    /// Bytes in the file once flushed (header included).
+    pub fn bytes_written(&self) -> u64 {
+        self.bytes
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for CsvSeries {
+    fn drop(&mut self) {
+        let _ = self.out.flush();
+    }
+}
+
+/// Writes a table of already formatted cells (text columns allowed). Cells containing a comma, quote or
+/// newline are quoted.
+pub fn write_table(path: &Path, header: &[&str], rows: &[Vec<String>]) -> io::Result<()> {
+    let quote = |s: &str| {
+        if s.contains([',', '"', '\n']) {
+            format!("\"{}\"", s.replace('"', "\"\""))
+        } else {
+            s.to_owned()
+        }
+    };
+    let mut out = String::new();
+    out.push_str(&header.iter().map(|h| quote(h)).collect::<Vec<_>>().join(","));
+    out.push('\n');
+    for r in rows {
+        out.push_str(&r.iter().map(|c| quote(c)).collect::<Vec<_>>().join(","));
+        out.push('\n');
+    }
+    std::fs::write(path, out).map_err(|e| with_path(e, path))
+}
+
+/// Reads a numeric CSV written by [`CsvSeries`]: the header and the rows.
+pub fn read_series(path: &Path) -> io::Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let text = std::fs::read_to_string(path).map_err(|e| with_path(e, path))?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap_or("").split(',').map(str::to_owned).collect();
+    let mut rows = Vec::new();
+    for (i, l) in lines.enumerate() {
+        let row: Result<Vec<f64>, _> = l.split(',').map(str::parse).collect();
+        rows.push(row.map_err(|_| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{} line {}: not numbers", path.display(), i + 2),
+            )
+        })?);
+    }
+    Ok((header, rows))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resume_cuts_back_and_appends() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s.csv");
+        let mut a = CsvSeries::create(&p, &["t_s", "ke_J"]).unwrap();
+        a.row(&[0.0, 1.0]).unwrap();
+        let mark = a.bytes_written();
+        a.row(&[0.1, 0.5]).unwrap(); // written after the checkpoint, lost on interruption
+        drop(a);
+        let mut b = CsvSeries::resume(&p, &["t_s", "ke_J"], mark).unwrap();
+        b.row(&[0.1, 0.25]).unwrap();
+        drop(b);
+        let (h, rows) = read_series(&p).unwrap();
+        assert_eq!(h, vec!["t_s", "ke_J"]);
+        assert_eq!(rows, vec![vec![0.0, 1.0], vec![0.1, 0.25]]);
+        let mut c = CsvSeries::create(&p, &["a"]).unwrap();
+        assert!(c.row(&[1.0, 2.0]).is_err(), "width mismatch is an error");
+    }
+}

@@ -1,0 +1,481 @@
+//! Pictures: line/marker charts (PNG or SVG) and colour maps of values on triangle meshes.
+//!
+//! Text is drawn with DejaVu Sans embedded in the binary (`assets/fonts`), so pictures render the same on
+//! every machine without system fonts.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use spatter_core::mesh::TriMesh;
+use spatter_core::Vec3;
+use std::io;
+use std::path::Path;
+use std::sync::Once;
+
+static FONT: Once = Once::new();
+const FONT_BYTES: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+
+fn ensure_font() {
+    FONT.call_once(|| {
+        // The embedded font is valid; if registration failed text would be missing, never a crash.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES);
+    });
+}
+
+fn err(path: &Path, e: impl std::fmt::Display) -> io::Error {
+    io::Error::other(format!("cannot draw {}: {e}", path.display()))
+}
+
+#[derive(Clone, Debug)]
+enum Kind {
+    Line,
+    Markers,
+    Dashed,
+}
+
+#[derive(Clone, Debug)]
+struct Series {
+    label: String,
+    points: Vec<(f64, f64)>,
+    kind: Kind,
+    color: RGBColor,
+}
+
+/// A chart of lines and markers with optional logarithmic axes.
+#[derive(Clone, Debug)]
+pub struct Chart {
+    title: String,
+    x_label: String,
+    y_label: String,
+    log_x: bool,
+    log_y: bool,
+    x_range: Option<(f64, f64)>,
+    y_range: Option<(f64, f64)>,
+    size: (u32, u32),
+    series: Vec<Series>,
+}
+
+/// A short tick label: plain notation for moderate magnitudes, `2.5e-6` style otherwise, with trailing
+/// zeros removed.
+pub fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        return "0".into();
+    }
+    if (1e-3..1e4).contains(&a) {
+        let s = format!("{:.4}", v);
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        return s.to_owned();
+    }
+    let s = format!("{:.3e}", v);
+    match s.split_once('e') {
+        Some((m, e)) => format!("{}e{}", m.trim_end_matches('0').trim_end_matches('.'), e),
+        None => s,
+    }
+}
+
+/// Colours assigned to series without an explicit colour (colour-blind friendly, Okabe–Ito).
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
+impl Chart {
+    pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
+        Chart {
+            title: title.to_owned(),
+            x_label: x_label.to_owned(),
+            y_label: y_label.to_owned(),
+            log_x: false,
+            log_y: false,
+            x_range: None,
+            y_range: None,
+            size: (900, 650),
+            series: Vec::new(),
+        }
+    }
+
+    pub fn log_x(mut self) -> Self {
+        self.log_x = true;
+        self
+    }
+
+    pub fn log_y(mut self) -> Self {
+        self.log_y = true;
+        self
+    }
+
+    /// Fixes the x range instead of fitting it to the data.
+    pub fn x_range(mut self, lo: f64, hi: f64) -> Self {
+        self.x_range = Some((lo, hi));
+        self
+    }
+
+    pub fn y_range(mut self, lo: f64, hi: f64) -> Self {
+        self.y_range = Some((lo, hi));
+        self
+    }
+
+    /// Picture size in pixels.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.size = (width, height);
+        self
+    }
+
+    fn next_color(&self) -> RGBColor {
+        PALETTE[self.series.len() % PALETTE.len()]
+    }
+
+    pub fn line(mut self, label: &str, points: &[(f64, f64)]) -> Self {
+        let color = self.next_color();
+        self.series.push(Series { label: label.into(), points: points.to_vec(), kind: Kind::Line, color });
+        self
+    }
+
+    pub fn line_colored(mut self, label: &str, points: &[(f64, f64)], rgb: (u8, u8, u8)) -> Self {
+        let color = RGBColor(rgb.0, rgb.1, rgb.2);
+        self.series.push(Series { label: label.into(), points: points.to_vec(), kind: Kind::Line, color });
+        self
+    }
+
+    pub fn dashed(mut self, label: &str, points: &[(f64, f64)], rgb: (u8, u8, u8)) -> Self {
+        let color = RGBColor(rgb.0, rgb.1, rgb.2);
+        self.series.push(Series { label: label.into(), points: points.to_vec(), kind: Kind::Dashed, color });
+        self
+    }
+
+    pub fn markers(mut self, label: &str, points: &[(f64, f64)], rgb: (u8, u8, u8)) -> Self {
+        let color = RGBColor(rgb.0, rgb.1, rgb.2);
+        self.series.push(Series { label: label.into(), points: points.to_vec(), kind: Kind::Markers, color });
+        self
+    }
+
+    fn usable(&self, (x, y): (f64, f64)) -> bool {
+        x.is_finite() && y.is_finite() && (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0)
+    }
+
+    fn bounds(&self) -> ((f64, f64), (f64, f64)) {
+        let pts = self.series.iter().flat_map(|s| s.points.iter().copied()).filter(|p| self.usable(*p));
+        let (mut x0, mut x1, mut y0, mut y1) =
+            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+        for (x, y) in pts {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        let pad = |lo: f64, hi: f64, log: bool| -> (f64, f64) {
+            if !lo.is_finite() {
+                return if log { (0.1, 10.0) } else { (0.0, 1.0) };
+            }
+            if log {
+                let (a, b) = (lo.log10(), hi.log10());
+                let m = ((b - a) * 0.05).max(0.05);
+                (10f64.powf(a - m), 10f64.powf(b + m))
+            } else {
+                let m = if hi > lo { (hi - lo) * 0.05 } else { lo.abs().max(1.0) * 0.05 };
+                (lo - m, hi + m)
+            }
+        };
+        (
+            self.x_range.unwrap_or_else(|| pad(x0, x1, self.log_x)),
+            self.y_range.unwrap_or_else(|| pad(y0, y1, self.log_y)),
+        )
+    }
+
+    /// Writes the chart as PNG.
+    pub fn save_png(&self, path: &Path) -> io::Result<()> {
+        ensure_font();
+        let root = BitMapBackend::new(path, self.size).into_drawing_area();
+        self.draw(&root).map_err(|e| err(path, e))?;
+        root.present().map_err(|e| err(path, e))
+    }
+
+    /// Writes the chart as SVG.
+    pub fn save_svg(&self, path: &Path) -> io::Result<()> {
+        ensure_font();
+        let root = SVGBackend::new(path, self.size).into_drawing_area();
+        self.draw(&root).map_err(|e| err(path, e))?;
+        root.present().map_err(|e| err(path, e))
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let ((x0, x1), (y0, y1)) = self.bounds();
+        match (self.log_x, self.log_y) {
+            (false, false) => self.draw_in(root, x0..x1, y0..y1),
+            (true, false) => self.draw_in(root, (x0..x1).log_scale(), y0..y1),
+            (false, true) => self.draw_in(root, x0..x1, (y0..y1).log_scale()),
+            (true, true) => self.draw_in(root, (x0..x1).log_scale(), (y0..y1).log_scale()),
+        }
+    }
+
+    fn draw_in<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, xr: X, yr: Y) -> Result<(), String>
+    where
+        DB: DrawingBackend,
+        X: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+        Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+        X::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+        Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+    {
+        let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, ("sans-serif", 22))
+            .margin(14)
+            .x_label_area_size(48)
+            .y_label_area_size(78)
+            .build_cartesian_2d(xr, yr)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 16))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(e)?;
+        let mut any_label = false;
+        for s in &self.series {
+            let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| self.usable(*p)).collect();
+            let color = s.color;
+            let anno = match s.kind {
+                Kind::Line => chart.draw_series(LineSeries::new(pts, color.stroke_width(2))).map_err(e)?,
+                Kind::Dashed => {
+                    chart.draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(2))).map_err(e)?
+                }
+                Kind::Markers => chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
+                    .map_err(e)?,
+            };
+            if !s.label.is_empty() {
+                any_label = true;
+                anno.label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(3)));
+            }
+        }
+        if any_label {
+            chart
+                .configure_series_labels()
+                .label_font(("sans-serif", 14))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(e)?;
+        }
+        Ok(())
+    }
+}
+
+/// Perceptually uniform colour map (viridis, sampled at nine stops and interpolated linearly).
+pub fn viridis(t: f64) -> (u8, u8, u8) {
+    const STOPS: [(f64, f64, f64); 9] = [
+        (68.0, 1.0, 84.0),
+        (71.0, 44.0, 122.0),
+        (59.0, 81.0, 139.0),
+        (44.0, 113.0, 142.0),
+        (33.0, 144.0, 141.0),
+        (39.0, 173.0, 129.0),
+        (92.0, 200.0, 99.0),
+        (170.0, 220.0, 50.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let x = t * 8.0;
+    let k = (x as usize).min(7);
+    let f = x - k as f64;
+    let (a, b) = (STOPS[k], STOPS[k + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round() as u8;
+    (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// Renders `mesh` seen along `view_dir` (orthographic, `up` towards the top of the picture), each triangle
+/// coloured by its value; NaN values are drawn grey ("no data"). A colour bar labelled `colorbar_label`
+/// shows the scale from 0 (or the minimum, if negative) to the maximum.
+pub fn mesh_map_png(
+    path: &Path,
+    mesh: &TriMesh,
+    values: &[f64],
+    view_dir: Vec3,
+    up: Vec3,
+    title: &str,
+    colorbar_label: &str,
+) -> io::Result<()> {
+    if values.len() != mesh.triangles.len() {
+        return Err(err(path, format!("{} values for {} triangles", values.len(), mesh.triangles.len())));
+    }
+    ensure_font();
+    let d = view_dir.normalize_or_zero();
+    let right = d.cross(up).normalize_or_zero();
+    if d == Vec3::ZERO || right == Vec3::ZERO {
+        return Err(err(path, "view direction and up vector must be non-zero and not parallel"));
+    }
+    let screen_up = right.cross(d);
+    let project = |p: Vec3| (p.dot(right), p.dot(screen_up));
+    let (mut x0, mut x1, mut y0, mut y1) =
+        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for v in &mesh.vertices {
+        let (x, y) = project(*v);
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if !x0.is_finite() {
+        return Err(err(path, "mesh has no vertices"));
+    }
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
+    let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
+    let (vmin, vmax) = if vmax.is_finite() && vmax > vmin { (vmin, vmax) } else { (0.0, 1.0) };
+
+    // Painter's algorithm: far triangles first.
+    let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
+    let depth: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.centroid(t).dot(d)).collect();
+    order.sort_by(|&a, &b| depth[b].total_cmp(&depth[a]));
+
+    // Keep the picture's aspect equal to the geometry's.
+    let (w, h) = (1000u32, 760u32);
+    let plot_w = w - 150;
+    let span_x = (x1 - x0).max(1e-300);
+    let span_y = (y1 - y0).max(1e-300);
+    let scale = ((plot_w - 60) as f64 / span_x).min((h - 110) as f64 / span_y);
+    let cx = 0.5 * (x0 + x1);
+    let cy = 0.5 * (y0 + y1);
+    let half_x = 0.5 * (plot_w - 60) as f64 / scale;
+    let half_y = 0.5 * (h - 110) as f64 / scale;
+
+    let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| err(path, x))?;
+    let (left, bar) = root.split_horizontally(plot_w);
+    let mut chart = ChartBuilder::on(&left)
+        .caption(title, ("sans-serif", 22))
+        .margin(20)
+        .build_cartesian_2d((cx - half_x)..(cx + half_x), (cy - half_y)..(cy + half_y))
+        .map_err(|x| err(path, x))?;
+    let shade = |v: f64| -> RGBColor {
+        if v.is_finite() {
+            let (r, g, b) = viridis((v - vmin) / (vmax - vmin));
+            RGBColor(r, g, b)
+        } else {
+            RGBColor(200, 200, 200)
+        }
+    };
+    chart
+        .draw_series(order.iter().map(|&t| {
+            let [a, b, c] = mesh.corners(t);
+            Polygon::new(vec![project(a), project(b), project(c)], shade(values[t]).filled())
+        }))
+        .map_err(|x| err(path, x))?;
+    // Colour bar.
+    let bar_top = 80i32;
+    let bar_bottom = h as i32 - 80;
+    let steps = 100;
+    let y_at = |f: f64| bar_bottom - ((bar_bottom - bar_top) as f64 * f).round() as i32;
+    for k in 0..steps {
+        let t0 = k as f64 / steps as f64;
+        let (y_hi, y_lo) = (y_at((k + 1) as f64 / steps as f64), y_at(t0));
+        let (r, g, b) = viridis(t0);
+        bar.draw(&Rectangle::new([(20, y_hi), (45, y_lo)], RGBColor(r, g, b).filled()))
+            .map_err(|x| err(path, x))?;
+    }
+    bar.draw(&Rectangle::new([(20, bar_top), (45, bar_bottom)], BLACK.stroke_width(1)))
+        .map_err(|x| err(path, x))?;
+    for k in 0..=4 {
+        let f = k as f64 / 4.0;
+        let y = bar_bottom - ((bar_bottom - bar_top) as f64 * f) as i32;
+        let label = tick_label(vmin + f * (vmax - vmin));
+        bar.draw(&Text::new(label, (50, y - 7), ("sans-serif", 13))).map_err(|x| err(path, x))?;
+    }
+    bar.draw(&Text::new(colorbar_label.to_owned(), (5, bar_top - 40), ("sans-serif", 14)))
+        .map_err(|x| err(path, x))?;
+    root.present().map_err(|x| err(path, x))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn png_size(p: &Path) -> (u32, u32) {
+        let b = std::fs::read(p).unwrap();
+        assert_eq!(&b[1..4], b"PNG");
+        (u32::from_be_bytes(b[16..20].try_into().unwrap()), u32::from_be_bytes(b[20..24].try_into().unwrap()))
+    }
+
+    #[test]
+    fn charts_render_png_and_svg() {
+        let dir = tempfile::tempdir().unwrap();
+        let pts: Vec<(f64, f64)> = (1..50).map(|i| (i as f64, (i as f64).powf(-0.8))).collect();
+        let c = Chart::new("power law", "d [m]", "v [m/s]").log_x().log_y().line("fit", &pts).markers(
+            "data",
+            &pts,
+            (200, 0, 0),
+        );
+        c.save_png(&dir.path().join("a.png")).unwrap();
+        c.save_svg(&dir.path().join("a.svg")).unwrap();
+        assert_eq!(png_size(&dir.path().join("a.png")), (900, 650));
+        let svg = std::fs::read_to_string(dir.path().join("a.svg")).unwrap();
+        assert!(svg.contains("power law"));
+    }
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(4.999999999999999e-6), "5e-6");
+        assert_eq!(tick_label(0.25), "0.25");
+        assert_eq!(tick_label(1200.0), "1200");
+        assert_eq!(tick_label(2.5e7), "2.5e7");
+    }
+
+    #[test]
+    fn mesh_map_renders_and_checks_lengths() {
+        let dir = tempfile::tempdir().unwrap();
+        let m = TriMesh::rectangle(2.0, 1.0, 0.0, 4, 2);
+        let vals: Vec<f64> = (0..m.triangles.len()).map(|t| t as f64).collect();
+        let p = dir.path().join("m.png");
+        mesh_map_png(&p, &m, &vals, -Vec3::Z, Vec3::Y, "test", "mass [kg/m²]").unwrap();
+        assert_eq!(png_size(&p), (1000, 760));
+        assert!(mesh_map_png(&p, &m, &vals[1..], -Vec3::Z, Vec3::Y, "t", "x").is_err());
+        assert!(mesh_map_png(&p, &m, &vals, Vec3::Y, Vec3::Y, "t", "x").is_err());
+    }
+}
+
+#[cfg(test)]
+mod picture_check {
+    use super::*;
+    /// Writes sample pictures to `$SPATTER_PICTURE_DIR` for looking at by eye (skipped when unset).
+    #[test]
+    fn sample_pictures() {
+        let Ok(dir) = std::env::var("SPATTER_PICTURE_DIR") else { return };
+        let dir = Path::new(&dir);
+        let pts: Vec<(f64, f64)> = (1..50).map(|i| (i as f64 * 1e-6, 0.3 * (i as f64).powf(-0.8))).collect();
+        Chart::new("critical speed", "diameter [m]", "v_crit [m/s]")
+            .log_x()
+            .log_y()
+            .line("fit", &pts)
+            .markers("stick", &pts[..10], (200, 30, 30))
+            .save_png(&dir.join("chart.png"))
+            .unwrap();
+        let mut m = TriMesh::rectangle(2.0, 1.0, 0.0, 20, 10);
+        m.map_vertices(|v| Vec3::new(v.x, v.y, 0.3 * (v.x * 3.0).sin()));
+        let vals: Vec<f64> = (0..m.triangles.len()).map(|t| m.centroid(t).x * m.centroid(t).y).collect();
+        mesh_map_png(
+            &dir.join("mesh.png"),
+            &m,
+            &vals,
+            Vec3::new(-0.3, -0.5, -1.0),
+            Vec3::Y,
+            "deposit",
+            "kg/m²",
+        )
+        .unwrap();
+    }
+}

@@ -1,0 +1,77 @@
+//! The run folder and the context a job runs in.
+//!
+//! A run writes one folder: `run.toml` (the fully resolved input), `log.txt`, CSV time series, VTU/PVD
+//! snapshots, pictures, and `checkpoint.bin` while it is unfinished.
+
+use spatter_core::control::{Finished, RunControl};
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// A run's output folder.
+#[derive(Clone, Debug)]
+pub struct RunDir {
+    root: PathBuf,
+}
+
+impl RunDir {
+    /// Uses `root` as the run folder, creating it (and its parents) if needed.
+    pub fn create(root: &Path) -> io::Result<Self> {
+        std::fs::create_dir_all(root).map_err(|e| {
+            io::Error::new(e.kind(), format!("cannot create run folder {}: {e}", root.display()))
+        })?;
+        Ok(RunDir { root: root.to_owned() })
+    }
+
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// `root/rel`, with the parent folders of that path created.
+    pub fn path(&self, rel: &str) -> PathBuf {
+        let p = self.root.join(rel);
+        if let Some(parent) = p.parent() {
+            // Creation errors surface when the file itself is written.
+            let _ = std::fs::create_dir_all(parent);
+        }
+        p
+    }
+
+    /// Writes `text` to `root/rel` and returns the full path.
+    pub fn write_text(&self, rel: &str, text: &str) -> io::Result<PathBuf> {
+        let p = self.path(rel);
+        std::fs::write(&p, text)
+            .map_err(|e| io::Error::new(e.kind(), format!("cannot write {}: {e}", p.display())))?;
+        Ok(p)
+    }
+
+    /// Path of the job's checkpoint file.
+    pub fn checkpoint_path(&self) -> PathBuf {
+        self.root.join("checkpoint.bin")
+    }
+}
+
+/// Everything a job needs from the program that starts it.
+pub struct RunContext<'a> {
+    /// Where outputs go.
+    pub dir: &'a RunDir,
+    /// Stop requests (Ctrl-C) and progress reporting.
+    pub control: &'a dyn RunControl,
+    /// Continue from `dir/checkpoint.bin` instead of starting afresh.
+    pub resume: bool,
+}
+
+/// What a job tells the user when it returns.
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    pub finished: Finished,
+    /// Lines worth printing (key results, counts, warnings).
+    pub headline: Vec<String>,
+    /// Labelled output files (pictures, tables) the user will want to open.
+    pub artifacts: Vec<(String, PathBuf)>,
+}
+
+impl RunSummary {
+    pub fn new(finished: Finished) -> Self {
+        RunSummary { finished, headline: Vec::new(), artifacts: Vec::new() }
+    }
+}
