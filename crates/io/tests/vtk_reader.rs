@@ -1,0 +1,73 @@
+//! Reads VTU files written by `spatter-io` with an independent reader: VTK's own `vtkXMLUnstructuredGridReader`
+//! through Python (Debian package `python3-vtk9`, installed by `.ci/run`).
+//!
+//! Without VTK on the machine the test reports that it skipped; with `SPATTER_REQUIRE_VTK=1` (set in CI) a
+//! missing VTK is a failure, so CI cannot pass without the check having run.
+
+use spatter_core::mesh::TriMesh;
+use spatter_core::Vec3;
+use spatter_io::vtu::Vtu;
+use std::process::Command;
+
+const PYTHON: &str = "/usr/bin/python3";
+
+fn vtk_available() -> bool {
+    Command::new(PYTHON).args(["-c", "import vtk"]).output().map(|o| o.status.success()).unwrap_or(false)
+}
+
+#[test]
+fn vtk_reads_particles_and_meshes() {
+    if !vtk_available() {
+        assert!(
+            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
+            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
+        );
+        eprintln!("skipped: python3-vtk9 is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let pos: Vec<Vec3> = (0..5).map(|i| Vec3::new(i as f64, 0.5 * i as f64, -1.0)).collect();
+    let vel: Vec<Vec3> = (0..5).map(|i| Vec3::new(0.0, i as f64, 1.0)).collect();
+    Vtu::point_cloud(&pos)
+        .point_scalar("radius_m", &[0.1, 0.2, 0.3, 0.4, 0.5])
+        .point_vector("velocity_m_s", &vel)
+        .point_int("id", &[10, 11, 12, 13, 14])
+        .write(&dir.path().join("p.vtu"))
+        .unwrap();
+    let mesh = TriMesh::rectangle(1.0, 2.0, 0.0, 2, 2);
+    let area: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.area(t)).collect();
+    Vtu::triangles(&mesh.vertices, &mesh.triangles)
+        .cell_scalar("area_m2", &area)
+        .cell_int("impacts", &[1, 2, 3, 4, 5, 6, 7, 8])
+        .write(&dir.path().join("m.vtu"))
+        .unwrap();
+    let script = r#"
+import sys, vtk
+def read(p):
+    r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(p); r.Update()
+    if r.GetErrorCode() != 0: raise SystemExit("reader error %d on %s" % (r.GetErrorCode(), p))
+    return r.GetOutput()
+p = read(sys.argv[1]); m = read(sys.argv[2])
+assert p.GetNumberOfPoints() == 5 and p.GetNumberOfCells() == 5
+ids = p.GetPointData().GetArray("id")
+assert [ids.GetValue(i) for i in range(5)] == [10, 11, 12, 13, 14]
+v = p.GetPointData().GetArray("velocity_m_s")
+assert v.GetNumberOfComponents() == 3 and v.GetTuple3(3)[1] == 3.0
+assert abs(p.GetPoint(4)[1] - 2.0) < 1e-15
+assert m.GetNumberOfPoints() == 9 and m.GetNumberOfCells() == 8 and m.GetCellType(0) == 5
+a = m.GetCellData().GetArray("area_m2")
+total = sum(a.GetValue(i) for i in range(8))
+assert abs(total - 2.0) < 1e-12, total
+assert m.GetCellData().GetArray("impacts").GetValue(7) == 8
+print("ok")
+"#;
+    let out = Command::new(PYTHON)
+        .args(["-c", script])
+        .arg(dir.path().join("p.vtu"))
+        .arg(dir.path().join("m.vtu"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stdout.trim() == "ok", "VTK rejected our files:\n{stdout}\n{stderr}");
+}
