@@ -1,1 +1,4 @@
 //! Soft-sphere discrete element engine.
+
+pub mod adhesion;
+pub mod restitution_models;
