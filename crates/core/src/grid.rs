@@ -103,6 +103,11 @@ impl CellGrid {
         (c[2] * dims[1] + c[1]) * dims[0] + c[0]
     }
 
+    /// Lower corner of cell (0, 0, 0) \[m\]: cell `(i, j, k)` spans `origin + [i, i+1)·cell_size` etc.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
     /// The cell edge actually used \[m\] (≥ the requested one).
     pub fn cell_size(&self) -> f64 {
         self.cell_size

@@ -4,6 +4,8 @@
 //! * [`material`] — elastic materials and effective pair properties (E*, G*, R*, m*);
 //! * [`mesh`] — triangle meshes, STL/OBJ readers, closest point on a triangle with face/edge/vertex regions;
 //! * [`grid`] — a cell-list neighbour search shared by DEM and SPH;
+//! * [`tri_bvh`] — a triangle hierarchy: segment crossings, closest points, inside tests;
+//! * [`surface_sample`] — boundary-particle sampling of a mesh surface at a given spacing;
 //! * [`motion`] — prescribed rigid-body kinematics (constant, rotating, tabulated, hierarchical);
 //! * [`distribution`] — particle size distributions;
 //! * [`timestep`] — Rayleigh and Hertz time-step estimates;
@@ -26,7 +28,9 @@ pub mod mesh;
 pub mod motion;
 pub mod regime;
 pub mod rng;
+pub mod surface_sample;
 pub mod timestep;
+pub mod tri_bvh;
 pub mod validation;
 
 pub use aabb::Aabb;
