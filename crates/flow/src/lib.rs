@@ -1,1 +1,9 @@
-//! Particle-fluid forces, flow fields, Lagrangian tracker and deposition.
+//! `spatter-flow`: particles in air.
+//!
+//! * [`forces`] — the particle–fluid force library (drag laws, lift, torque, history, added mass, pressure
+//!   gradient, gravity/buoyancy, wall-bounded lift) and the nondimensional force ranking;
+//!
+//! Every quantity is SI. Forces are per unit particle mass (accelerations) unless a function says
+//! otherwise.
+
+pub mod forces;
