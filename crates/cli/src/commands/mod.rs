@@ -1,0 +1,88 @@
+//! One function per subcommand.
+
+pub mod run;
+
+use crate::registry;
+use anyhow::Result;
+use spatter_core::validation::Tolerance;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Exit code for a scenario file with errors.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+/// Prints every scenario error, one per line, and how many there were.
+pub fn report_errors(errors: &[spatter_scenario::ScenarioError]) {
+    for e in errors {
+        eprintln!("error: {e}");
+    }
+    if errors.len() > 1 {
+        eprintln!("{} problems found; nothing was run.", errors.len());
+    }
+}
+
+/// `spatter check`: validate and print the resolved input.
+pub fn check(path: &Path) -> Result<ExitCode> {
+    match spatter_scenario::load(path) {
+        Ok(loaded) => {
+            let text = loaded.scenario.resolved_toml().map_err(anyhow::Error::msg)?;
+            print!("{text}");
+            eprintln!("{}: valid `{}` scenario", path.display(), loaded.scenario.kind());
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(errors) => {
+            report_errors(&errors);
+            Ok(ExitCode::from(EXIT_BAD_INPUT))
+        }
+    }
+}
+
+/// `spatter validate`: run the registered cases and print one line per compared quantity.
+pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
+    let cases: Vec<_> = registry::validation_cases()
+        .into_iter()
+        .filter(|c| filter.is_none_or(|f| c.name.contains(f)))
+        .collect();
+    if cases.is_empty() {
+        anyhow::bail!("no validation case matches {:?}", filter.unwrap_or(""));
+    }
+    println!(
+        "{:<34} {:<30} {:>13} {:>13} {:>10} {:>10}  {}",
+        "case", "quantity", "reference", "ours", "rel.error", "tolerance", "result"
+    );
+    let (mut passed, mut failed) = (0, 0);
+    for case in cases {
+        for c in (case.run)(quick) {
+            let tol = match c.tolerance {
+                Tolerance::Relative(t) => format!("{:.1e}", t),
+                Tolerance::Absolute(t) => format!("±{:.1e}", t),
+            };
+            let ok = c.passed();
+            if ok {
+                passed += 1
+            } else {
+                failed += 1
+            }
+            println!(
+                "{:<34} {:<30} {:>13.6e} {:>13.6e} {:>10.2e} {:>10}  {}",
+                c.case,
+                c.quantity,
+                c.reference,
+                c.ours,
+                c.error(),
+                tol,
+                if ok { "pass" } else { "FAIL" }
+            );
+        }
+    }
+    println!("\n{passed} passed, {failed} failed{}", if quick { " (quick variants)" } else { "" });
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// `spatter bench <engine>`.
+pub fn bench(engine: &str, quick: bool) -> Result<ExitCode> {
+    for line in registry::run_bench(engine, quick)? {
+        println!("{line}");
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,130 @@
+//! The registry of scenario kinds: the value of the top-level `kind` key, the configuration type it is
+//! read into, and the function that runs it.
+//!
+//! Adding a kind is one line in the `kinds!` invocation below: the name, the variant, the configuration
+//! type (serde + [`Validate`]) and its `run(&Config, &RunContext) -> Result<RunSummary, E>` function.
+
+#[allow(unused_imports)]
+use crate::parse::{typed, validate, ScenarioError};
+use crate::source::Source;
+use serde::Serialize;
+use spatter_core::check::Validate;
+use spatter_io::run::{RunContext, RunSummary};
+use std::path::Path;
+
+/// Error returned by a running scenario.
+pub type RunError = Box<dyn std::error::Error + Send + Sync>;
+
+macro_rules! kinds {
+    ($( $name:literal => $variant:ident($cfg:ty, $run:path), $doc:literal; )*) => {
+        /// Every accepted value of `kind`.
+        pub const KINDS: &[&str] = &[$($name),*];
+
+        /// A scenario read and validated from a file.
+        #[derive(Debug)]
+        #[allow(clippy::large_enum_variant)]
+        pub enum Scenario {
+            $( #[doc = $doc] $variant($cfg), )*
+        }
+
+        impl Scenario {
+            /// The `kind` this scenario was read as.
+            pub fn kind(&self) -> &'static str {
+                match *self { $( Scenario::$variant(_) => $name, )* }
+            }
+
+            /// Runs the scenario in `ctx`.
+            pub fn run(&self, ctx: &RunContext) -> Result<RunSummary, RunError> {
+                match *self { $( Scenario::$variant(ref c) => $run(c, ctx).map_err(|e| Box::new(e) as RunError), )* }
+            }
+
+            /// The fully resolved input as TOML (`kind` first, every default filled in).
+            pub fn resolved_toml(&self) -> Result<String, String> {
+                match *self { $( Scenario::$variant(ref c) => resolved($name, c), )* }
+            }
+
+            #[allow(unused_variables)]
+            fn read(kind: &str, src: &Source, body: &str) -> Result<Option<Self>, Vec<ScenarioError>> {
+                match kind {
+                    $( $name => {
+                        let cfg: $cfg = typed(src, body).map_err(|e| vec![e])?;
+                        validate(src, &cfg)?;
+                        Ok(Some(Scenario::$variant(cfg)))
+                    } )*
+                    _ => Ok(None),
+                }
+            }
+        }
+    };
+}
+
+kinds! {}
+
+fn resolved<T: Serialize>(kind: &str, cfg: &T) -> Result<String, String> {
+    let body = toml::to_string(cfg).map_err(|e| e.to_string())?;
+    Ok(format!("# Fully resolved input, every default filled in.\nkind = \"{kind}\"\n{body}"))
+}
+
+/// A scenario together with its source file.
+#[derive(Debug)]
+pub struct Loaded {
+    pub scenario: Scenario,
+    pub source: Source,
+}
+
+/// Reads, parses and validates the scenario file at `path`.
+pub fn load(path: &Path) -> Result<Loaded, Vec<ScenarioError>> {
+    let source = Source::read(path).map_err(|e| vec![e])?;
+    load_source(source)
+}
+
+/// Like [`load`] for text already in memory; `path` is used in messages and to resolve relative paths.
+pub fn load_str(path: &Path, text: &str) -> Result<Loaded, Vec<ScenarioError>> {
+    let source = Source::from_bytes(path, text.as_bytes()).map_err(|e| vec![e])?;
+    load_source(source)
+}
+
+fn load_source(source: Source) -> Result<Loaded, Vec<ScenarioError>> {
+    // Syntax first: a file that is not TOML gets the parser's located message.
+    let table: toml::Table = typed(&source, &source.text).map_err(|e| vec![e])?;
+    let expected = || format!("one of: {}", KINDS.join(", "));
+    let kind = match table.get("kind") {
+        Some(toml::Value::String(s)) => s.clone(),
+        Some(other) => {
+            let span = source.key_value_span("kind").unwrap_or(0..0);
+            return Err(vec![ScenarioError::at(
+                &source,
+                span.start,
+                Some("kind".into()),
+                format!("kind = {other} must be a string, {}", expected()),
+            )]);
+        }
+        None => {
+            return Err(vec![ScenarioError::at(
+                &source,
+                0,
+                Some("kind".into()),
+                format!("missing key `kind` at the top of the file; expected {}", expected()),
+            )])
+        }
+    };
+    // Blank the `kind = …` line with spaces so every other byte keeps its position for error messages.
+    let span = source.key_value_span("kind").unwrap_or(0..0);
+    let mut body = source.text.clone();
+    body.replace_range(span.clone(), &" ".repeat(span.len()));
+    match Scenario::read(&kind, &source, &body)? {
+        Some(scenario) => Ok(Loaded { scenario, source }),
+        None => {
+            let at = source.locate("kind").map(|(s, _)| s.start).unwrap_or(0);
+            Err(vec![ScenarioError::at(
+                &source,
+                at,
+                Some("kind".into()),
+                format!("unknown kind \"{kind}\"; expected {}", expected()),
+            )])
+        }
+    }
+}
+
+#[allow(dead_code)]
+fn assert_validate<T: Validate>() {}
