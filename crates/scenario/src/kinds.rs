@@ -34,6 +34,7 @@ macro_rules! kinds {
             }
 
             /// Runs the scenario in `ctx`.
+            #[allow(unused_variables)]
             pub fn run(&self, ctx: &RunContext) -> Result<RunSummary, RunError> {
                 match *self { $( Scenario::$variant(ref c) => $run(c, ctx).map_err(|e| Box::new(e) as RunError), )* }
             }
@@ -60,6 +61,7 @@ macro_rules! kinds {
 
 kinds! {}
 
+#[allow(dead_code)]
 fn resolved<T: Serialize>(kind: &str, cfg: &T) -> Result<String, String> {
     let body = toml::to_string(cfg).map_err(|e| e.to_string())?;
     Ok(format!("# Fully resolved input, every default filled in.\nkind = \"{kind}\"\n{body}"))
