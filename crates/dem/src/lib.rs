@@ -2,3 +2,5 @@
 
 pub mod adhesion;
 pub mod restitution_models;
+
+pub mod contact;

@@ -1,0 +1,102 @@
+//! The composed kernel: normal + damping + tangential + rolling, monomorphised.
+
+use super::{
+    ContactInput, ContactLaw, ContactOutput, DampingLaw, NormalLaw, PairProps, RollingLaw, TangentialLaw,
+};
+use serde::{Deserialize, Serialize};
+
+/// One law of each kind, combined into a [`ContactLaw`]. The laws themselves hold only global options
+/// (per-pair numbers live in [`ComposedParams`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Composed<N, D, T, R> {
+    pub normal: N,
+    pub damping: D,
+    pub tangential: T,
+    pub rolling: R,
+}
+
+impl<N, D, T, R> Composed<N, D, T, R> {
+    pub fn new(normal: N, damping: D, tangential: T, rolling: R) -> Self {
+        Composed { normal, damping, tangential, rolling }
+    }
+}
+
+/// Per-pair parameters of a [`Composed`] law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ComposedParams<NP, DP, TP, RP> {
+    pub normal: NP,
+    pub damping: DP,
+    pub tangential: TP,
+    pub rolling: RP,
+}
+
+/// Per-contact state of a [`Composed`] law.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComposedState<NS, DS, TS, RS> {
+    /// Set at first touch (the damping law's `on_formed` has run); cleared when the contact ends.
+    pub formed: bool,
+    pub normal: NS,
+    pub damping: DS,
+    pub tangential: TS,
+    pub rolling: RS,
+}
+
+impl<N, D, T, R> ContactLaw for Composed<N, D, T, R>
+where
+    N: NormalLaw,
+    D: DampingLaw,
+    T: TangentialLaw,
+    R: RollingLaw,
+{
+    type Params = ComposedParams<N::Params, D::Params, T::Params, R::Params>;
+    type State = ComposedState<N::State, D::State, T::State, R::State>;
+
+    fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params {
+        ComposedParams {
+            normal: self.normal.params(pair_index, props),
+            damping: self.damping.params(pair_index, props, self.normal.damping_exponent()),
+            tangential: self.tangential.params(pair_index, props),
+            rolling: self.rolling.params(pair_index, props),
+        }
+    }
+
+    #[inline]
+    fn range(&self, p: &Self::Params, r_eff: f64) -> f64 {
+        self.normal.range(&p.normal, r_eff)
+    }
+
+    #[inline]
+    fn compute(&self, p: &Self::Params, c: &ContactInput, s: &mut Self::State) -> Option<ContactOutput> {
+        let nf = self.normal.evaluate(&p.normal, c, &mut s.normal)?;
+        if !s.formed {
+            s.formed = true;
+            self.damping.on_formed(&p.damping, c, &mut s.damping);
+        }
+        let n = c.normal;
+        let vn = c.v_rel.dot(n);
+        let gamma_n = self.damping.normal_coefficient(&p.damping, &s.damping, &nf, c);
+        let mut f_n = nf.force - gamma_n * vn;
+        if self.damping.tensile_clamp(&p.damping) {
+            let floor = nf.force.min(0.0);
+            if f_n < floor {
+                f_n = floor;
+            }
+        }
+        // Power absorbed by the normal dashpot: −F_d·v_n ≥ 0.
+        let mut dissipation = -(f_n - nf.force) * vn;
+        let f_coulomb = nf.coulomb_force.unwrap_or(f_n.max(0.0));
+        let v_t = c.v_rel - vn * n;
+        let k_t = self.tangential.stiffness(&p.tangential, &nf, c);
+        let gamma_t = self.damping.tangential_coefficient(&p.damping, &s.damping, k_t, c);
+        let t = self.tangential.force(&p.tangential, &mut s.tangential, k_t, gamma_t, f_coulomb, v_t, c);
+        let (rolling_torque, roll_diss) = self.rolling.torque(&p.rolling, &mut s.rolling, f_coulomb, c);
+        dissipation += t.dissipation + roll_diss;
+        Some(ContactOutput {
+            force: f_n * n + t.force,
+            normal_force: f_n,
+            rolling_torque,
+            dissipation,
+            energy: nf.energy + t.energy,
+        })
+    }
+}
