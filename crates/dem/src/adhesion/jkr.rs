@@ -36,8 +36,20 @@ pub const LOAD_CONTROLLED_BREAK_RATIO: f64 = -0.480_749_856_769_136_2;
 
 /// Normalised contact radius x = a/a₀ at first touch (δ = 0): (2/3)^{2/3}.
 pub fn touch_radius_ratio() -> f64 {
-    (2.0f64 / 3.0).powf(2.0 / 3.0)
+    TOUCH_RATIO
 }
+
+/// W_neck/(F_c δ_c) under displacement control: U at x = 6^{-2/3}.
+const NECK_WORK_CRITICAL: f64 = 0.935_502_783_271_927_7;
+
+/// W_neck/(F_c δ_c) under load control: U at x = 4^{-1/3}.
+const NECK_WORK_PULL_OFF: f64 = 0.462_014_008_967_729_9;
+
+/// (2/3)^{2/3}.
+const TOUCH_RATIO: f64 = 0.763_142_828_368_887_9;
+
+/// [`normalised_energy`] at the touch radius (2/3)^{2/3}: −0.8466138943830397.
+const TOUCH_ENERGY: f64 = -0.846_613_894_383_039_7;
 
 /// Where a formed JKR contact breaks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -195,9 +207,7 @@ impl Jkr {
     /// Energy \[J\] stored in a formed contact, U = ∫₀^δ F dδ′ (zero when the contact forms at δ = 0),
     /// for normalised root y. In x = y²: U = F_cδ_c 6^{1/3}[(16/5)x⁵ − (16/3)x^{7/2} + (4/3)x²] − U(x_touch).
     pub fn energy_of_root(&self, y: f64) -> f64 {
-        self.pull_off_force
-            * self.critical_overlap
-            * (normalised_energy(y * y) - normalised_energy(touch_radius_ratio()))
+        self.pull_off_force * self.critical_overlap * (normalised_energy(y * y) - TOUCH_ENERGY)
     }
 
     /// Energy \[J\] stored in a formed contact at overlap `delta` (see [`Jkr::energy_of_root`]).
@@ -205,12 +215,15 @@ impl Jkr {
         self.root(delta, None).map(|y| self.energy_of_root(y))
     }
 
-    /// Work \[J\] needed to pull a formed contact from δ = 0 to its break point: U(δ_break).
-    /// 0.935503 F_c δ_c under displacement control, 0.462014 F_c δ_c under load control.
+    /// Work \[J\] needed to pull a formed contact from δ = 0 to its break point: U(δ_break) =
+    /// 0.935503 F_c δ_c under displacement control, 0.462014 F_c δ_c under load control (closed form of
+    /// [`Jkr::energy_of_root`] at the break radius; checked against it in the tests).
     pub fn neck_work(&self, criterion: BreakCriterion) -> f64 {
-        let y =
-            self.root(self.break_overlap(criterion), None).expect("the break overlap lies on the JKR curve");
-        self.energy_of_root(y)
+        let k = match criterion {
+            BreakCriterion::CriticalOverlap => NECK_WORK_CRITICAL,
+            BreakCriterion::PullOffForce => NECK_WORK_PULL_OFF,
+        };
+        k * self.pull_off_force * self.critical_overlap
     }
 
     /// Largest impact speed \[m/s\] at which an undamped, purely elastic JKR impact of effective mass
@@ -388,6 +401,13 @@ mod tests {
         let exact = j.energy(b).unwrap() - j.energy(a).unwrap();
         assert!(rel(integral, exact) < 1e-6, "{integral} vs {exact}");
         assert!(j.energy(0.0).unwrap().abs() < 1e-12 * w);
+        assert!((normalised_energy(TOUCH_RATIO) - TOUCH_ENERGY).abs() < 1e-15);
+        assert!((TOUCH_RATIO - (2.0f64 / 3.0).powf(2.0 / 3.0)).abs() < 1e-15);
+        // The closed-form neck works equal the stored energy at the break radius.
+        for crit in [BreakCriterion::CriticalOverlap, BreakCriterion::PullOffForce] {
+            let y = j.root(j.break_overlap(crit), None).unwrap();
+            assert!(rel(j.neck_work(crit), j.energy_of_root(y)) < 1e-7, "{crit:?}");
+        }
     }
 
     #[test]

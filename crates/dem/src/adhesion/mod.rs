@@ -12,10 +12,12 @@
 
 pub mod dmt;
 pub mod jkr;
+pub mod laws;
 pub mod sjkr;
 pub mod tabor;
 
 pub use dmt::Dmt;
 pub use jkr::{BreakCriterion, Jkr, JkrEval, JkrState};
+pub use laws::{AdhesiveCoulomb, DmtLaw, JkrDamping, JkrLaw, SjkrLaw};
 pub use sjkr::SimplifiedJkr;
 pub use tabor::tabor_parameter;
