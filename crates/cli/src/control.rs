@@ -1,7 +1,7 @@
 //! The CLI's side of [`RunControl`]: a Ctrl-C flag and a progress bar with ETA.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use spatter_core::control::RunControl;
+use spatter_core::control::{RunControl, StopAfterPolls};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 
@@ -25,9 +25,13 @@ pub fn install_ctrlc() {
 }
 
 /// Progress bar + stop flag.
+///
+/// For tests and scripted checks, the environment variable `SPATTER_STOP_AFTER_POLLS=N` makes the run
+/// behave as if Ctrl-C were pressed just before its (N+1)-th poll — a deterministic interruption point.
 pub struct CliControl {
     bar: ProgressBar,
     flag: Arc<AtomicBool>,
+    stop_after: Option<StopAfterPolls>,
 }
 
 impl CliControl {
@@ -39,7 +43,12 @@ impl CliControl {
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        CliControl { bar, flag: stop_flag() }
+        let stop_after =
+            std::env::var("SPATTER_STOP_AFTER_POLLS").ok().and_then(|v| v.parse().ok()).map(StopAfterPolls::new);
+        if std::env::var("SPATTER_NO_PROGRESS").is_ok() {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        CliControl { bar, flag: stop_flag(), stop_after }
     }
 
     pub fn bar(&self) -> &ProgressBar {
@@ -53,6 +62,11 @@ impl CliControl {
 
 impl RunControl for CliControl {
     fn stop_requested(&self) -> bool {
+        if let Some(s) = &self.stop_after {
+            if s.stop_requested() {
+                self.flag.store(true, Ordering::SeqCst);
+            }
+        }
         self.flag.load(Ordering::SeqCst)
     }
 
