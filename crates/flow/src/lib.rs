@@ -6,4 +6,9 @@
 //! Every quantity is SI. Forces are per unit particle mass (accelerations) unless a function says
 //! otherwise.
 
+// Index loops over small fixed arrays (barycentric weights, 4×4 systems) read like the formulas.
+#![allow(clippy::needless_range_loop)]
+
+pub mod field;
 pub mod forces;
+pub mod vtk;

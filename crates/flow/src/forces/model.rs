@@ -87,7 +87,7 @@ impl Validate for ForceSwitches {
 }
 
 /// The fluid as seen by one particle at one instant.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluidLocal {
     /// Fluid velocity (including any turbulent fluctuation) \[m/s\].
     pub u: Vec3,
@@ -95,6 +95,12 @@ pub struct FluidLocal {
     pub grad: Mat3,
     /// Local time derivative ∂u/∂t \[m/s²\].
     pub du_dt: Vec3,
+}
+
+impl Default for FluidLocal {
+    fn default() -> Self {
+        FluidLocal { u: Vec3::ZERO, grad: Mat3::ZERO, du_dt: Vec3::ZERO }
+    }
 }
 
 impl FluidLocal {
