@@ -11,4 +11,5 @@
 
 pub mod field;
 pub mod forces;
+pub mod tracker;
 pub mod vtk;

@@ -93,6 +93,8 @@ pub struct History {
     pub w0: Vec3,
     /// Time since the particle's life started \[s\].
     pub age: f64,
+    /// Fluid velocity seen at the previous step (estimates the fluid's change over the coming step).
+    pub u_last: Vec3,
 }
 
 impl History {
@@ -100,7 +102,7 @@ impl History {
     pub fn new(window: usize, w0: Vec3) -> Self {
         let mut w = vec![Vec3::ZERO; window + 1];
         w[0] = w0;
-        History { w, head: 0, len: 1, w0, age: 0.0 }
+        History { w, head: 0, len: 1, w0, age: 0.0, u_last: Vec3::ZERO }
     }
 
     /// Records the slip at the end of a step of length `dt`.

@@ -1,0 +1,379 @@
+use super::inject::NewParcel;
+use super::walls::{Body, Restitution, WallRule};
+use super::*;
+use crate::field::analytic::{AnalyticField, AnalyticSet, ConstantTurbulence};
+use crate::field::special::erfc;
+use crate::forces::drag::DragLaw;
+use crate::forces::history::BassetSettings;
+use crate::forces::model::ForceSwitches;
+use crate::forces::{stokes_time, Fluid};
+use spatter_core::mesh::TriMesh;
+
+fn air() -> Fluid {
+    Fluid { density: 1.2, viscosity: 1.8e-5 }
+}
+
+fn uniform(u: Vec3) -> AnalyticSet {
+    AnalyticSet { parts: vec![AnalyticField::Uniform { velocity: u }], turbulence: None }
+}
+
+fn one(x: Vec3, v: Vec3, d: f64, rho: f64) -> NewParcel {
+    NewParcel { pos: x, vel: v, diameter: d, density: rho, count: 1.0 }
+}
+
+#[test]
+fn stokes_settling_is_exact_for_any_step() {
+    // v(t) = v_t (1 − e^(−t/τ)), z(t) = −v_t (t − τ(1 − e^(−t/τ))), v_t = (1 − ρ_f/ρ_p) g τ (Stokes):
+    // the exponential update is exact for constant u and a, even with Δt = 10 τ. Tolerance 1e-12.
+    let (d, rho) = (20e-6, 917.0);
+    let tau = stokes_time(&air(), d, rho);
+    for dt in [0.1 * tau, 10.0 * tau] {
+        let sw = ForceSwitches { drag: DragLaw::Stokes, ..Default::default() };
+        let mut tr = Tracker::new(
+            uniform(Vec3::ZERO),
+            ForceModel::new(air(), sw),
+            TrackSettings { dt, ..Default::default() },
+            vec![],
+        );
+        tr.add(one(Vec3::ZERO, Vec3::ZERO, d, rho), 0);
+        let vt = (1.0 - 1.2 / rho) * 9.81 * tau;
+        for _ in 0..20 {
+            tr.step().unwrap();
+        }
+        let t = tr.state.time;
+        let p = &tr.state.parcels[0];
+        let e = (-t / tau).exp();
+        assert!((p.vel.z + vt * (1.0 - e)).abs() < 1e-12 * vt, "dt/τ = {}", dt / tau);
+        assert!((p.pos.z + vt * (t - tau * (1.0 - e))).abs() < 1e-12 * vt * t);
+    }
+}
+
+#[test]
+fn schiller_naumann_settling_reaches_the_implicit_terminal_speed() {
+    // 300 µm sand in air: Re_t ≈ 30; the terminal speed solves (ρ_p − ρ_f) g V = ½ C_D ρ_f A v².
+    // Tolerance 1e-9 relative after 60 relaxation times with Δt = τ_p/5.
+    let (d, rho) = (300e-6, 2480.0);
+    let fluid = air();
+    let vt = DragLaw::SchillerNaumann.terminal_speed(&fluid, d, rho, 9.81);
+    let tau = stokes_time(&fluid, d, rho);
+    let mut tr = Tracker::new(
+        uniform(Vec3::ZERO),
+        ForceModel::new(fluid, ForceSwitches::default()),
+        TrackSettings { dt: tau / 5.0, ..Default::default() },
+        vec![],
+    );
+    tr.add(one(Vec3::ZERO, Vec3::ZERO, d, rho), 0);
+    for _ in 0..300 {
+        tr.step().unwrap();
+    }
+    let v = -tr.state.parcels[0].vel.z;
+    assert!((v / vt - 1.0).abs() < 1e-9, "{v} vs {vt}");
+    assert!(v < (1.0 - 1.2 / rho) * 9.81 * tau, "slower than Stokes");
+}
+
+#[test]
+fn relaxation_to_a_uniform_flow_is_exponential() {
+    // No gravity, Stokes drag: v = U(1 − e^(−t/τ)), x = U(t − τ(1 − e^(−t/τ))). Tolerance 1e-12.
+    let u = Vec3::new(10.0, -2.0, 1.0);
+    let (d, rho) = (50e-6, 1000.0);
+    let tau = stokes_time(&air(), d, rho);
+    let sw = ForceSwitches { drag: DragLaw::Stokes, gravity: Vec3::ZERO, ..Default::default() };
+    let mut tr = Tracker::new(
+        uniform(u),
+        ForceModel::new(air(), sw),
+        TrackSettings { dt: tau / 3.0, ..Default::default() },
+        vec![],
+    );
+    tr.add(one(Vec3::ZERO, Vec3::ZERO, d, rho), 0);
+    for _ in 0..10 {
+        tr.step().unwrap();
+    }
+    let t = tr.state.time;
+    let e = (-t / tau).exp();
+    let p = &tr.state.parcels[0];
+    assert!((p.vel - u * (1.0 - e)).length() < 1e-12 * u.length());
+    assert!((p.pos - u * (t - tau * (1.0 - e))).length() < 1e-12 * u.length() * t);
+}
+
+const LO_GAMMA: f64 = 1.0;
+const LO_RC: f64 = 0.05;
+const LO_R0: f64 = 0.1;
+
+/// Revolution time of the flow at r0.
+fn lo_period() -> f64 {
+    2.0 * std::f64::consts::PI * LO_R0 / crate::field::analytic::lamb_oseen_swirl(LO_GAMMA, LO_RC, LO_R0)
+}
+
+/// Final radius / r0 of a parcel released at rest at radius r0 in a Lamb–Oseen vortex after two
+/// revolutions of the flow at r0, for Stokes number St = τ_p/T (T the revolution time at r0).
+fn lamb_oseen_final_radius(st: f64) -> f64 {
+    let field = AnalyticSet {
+        parts: vec![AnalyticField::LambOseen {
+            circulation: LO_GAMMA,
+            core_radius: LO_RC,
+            centre: Vec3::ZERO,
+            axis: Vec3::Z,
+            nu: 0.0,
+        }],
+        turbulence: None,
+    };
+    let period = lo_period();
+    let fluid = air();
+    let d = 20e-6;
+    // ρ_p giving τ_p = St · T.
+    let rho = st * period * 18.0 * fluid.viscosity / (d * d);
+    let sw =
+        ForceSwitches { drag: DragLaw::Stokes, gravity: Vec3::ZERO, buoyancy: false, ..Default::default() };
+    let steps = 40_000;
+    let mut tr = Tracker::new(
+        field,
+        ForceModel::new(fluid, sw),
+        TrackSettings { dt: 2.0 * period / steps as f64, ..Default::default() },
+        vec![],
+    );
+    tr.add(one(Vec3::new(LO_R0, 0.0, 0.0), Vec3::ZERO, d, rho), 0);
+    for _ in 0..steps {
+        tr.step().unwrap();
+    }
+    tr.state.parcels[0].pos.length() / LO_R0
+}
+
+/// Small-St drift: a particle slips outward at dr/dt = τ_p v(r)²/r (Maxey 1987: v_p ≈ u − τ_p Du/Dt,
+/// and Du/Dt = −v²/r in a vortex). Integrated by RK4 over two revolutions; returns r/r0.
+fn small_st_drift(st: f64) -> f64 {
+    let tau = st * lo_period();
+    let f = |r: f64| tau * crate::field::analytic::lamb_oseen_swirl(LO_GAMMA, LO_RC, r).powi(2) / r;
+    let n = 10_000;
+    let h = 2.0 * lo_period() / n as f64;
+    let mut r = LO_R0;
+    for _ in 0..n {
+        let k1 = f(r);
+        let k2 = f(r + 0.5 * h * k1);
+        let k3 = f(r + 0.5 * h * k2);
+        let k4 = f(r + h * k3);
+        r += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+    r / LO_R0
+}
+
+#[test]
+fn lamb_oseen_heavier_particles_centrifuge_out() {
+    // Denser-than-fluid particles drift outward, faster for larger St (Maxey 1987). For St = 10⁻³ the
+    // drift over two turns (7 %) matches the small-St law within 0.005 of r0 (the stepping error of
+    // 20 000 steps per turn is 2π²/N ≈ 0.1 % per turn).
+    let sts = [1e-3, 0.03, 0.1, 0.3];
+    let radii: Vec<f64> = sts.iter().map(|&st| lamb_oseen_final_radius(st)).collect();
+    let predicted = small_st_drift(sts[0]);
+    assert!((radii[0] - predicted).abs() < 0.005, "St = 1e-3: {} vs small-St law {predicted}", radii[0]);
+    for w in radii.windows(2) {
+        assert!(w[1] > w[0], "radius must grow with St: {radii:?}");
+    }
+    assert!(radii[3] > 1.5, "{radii:?}");
+}
+
+fn plate_body(rule: WallRule) -> Body {
+    // 1 m × 1 m plate at z = 0 centred on the origin.
+    let mut m = TriMesh::rectangle(1.0, 1.0, 0.0, 4, 4);
+    m.map_vertices(|v| v - Vec3::new(0.5, 0.5, 0.0));
+    Body::new("plate", m, rule)
+}
+
+#[test]
+fn wall_rules_reflect_trap_escape_and_regime_map() {
+    let sw = ForceSwitches { drag_enabled: false, gravity: Vec3::ZERO, ..Default::default() };
+    let run = |rule: WallRule, v: Vec3| {
+        let mut tr = Tracker::new(
+            uniform(Vec3::ZERO),
+            ForceModel::new(air(), sw.clone()),
+            TrackSettings { dt: 1e-3, ..Default::default() },
+            vec![plate_body(rule)],
+        );
+        tr.add(one(Vec3::new(0.01, 0.02, 0.0105), v, 30e-6, 917.0), 0);
+        for _ in 0..40 {
+            tr.step().unwrap();
+        }
+        tr
+    };
+    let v = Vec3::new(0.5, 0.0, -2.0);
+    let tr = run(WallRule::Reflect(Restitution { normal: 0.5, tangential: 0.8 }), v);
+    let p = &tr.state.parcels[0];
+    assert_eq!(p.status, Status::Airborne);
+    assert!((p.vel - Vec3::new(0.4, 0.0, 1.0)).length() < 1e-12, "{}", p.vel);
+    assert!(p.pos.z > 0.0);
+    assert_eq!(tr.state.deposits[0].impacts.iter().sum::<u64>(), 1);
+    let tr = run(WallRule::Trap, v);
+    assert_eq!(tr.state.parcels[0].status, Status::Deposited);
+    assert!(tr.state.parcels[0].pos.z.abs() < 1e-15);
+    let dep: f64 = tr.state.deposits[0].mass.iter().sum();
+    assert_eq!(dep, tr.state.parcels[0].mass());
+    let tr = run(WallRule::Escape, v);
+    assert_eq!(tr.state.parcels[0].status, Status::Escaped);
+    // Regime map with v_crit = 1 m/s: 0.5 m/s sticks, 2 m/s bounces.
+    let map = || WallRule::RegimeMap {
+        map: walls::tests_support::map(1.0),
+        bounce: Restitution { normal: 0.3, tangential: 1.0 },
+        max_tangential_speed: None,
+        max_wall_shear: None,
+    };
+    assert_eq!(run(map(), Vec3::new(0.0, 0.0, -0.5)).state.parcels[0].status, Status::Deposited);
+    let tr = run(map(), v);
+    assert_eq!(tr.state.parcels[0].status, Status::Airborne);
+    assert!((tr.state.parcels[0].vel.z - 0.6).abs() < 1e-12);
+}
+
+/// A busy run: dispersion, gravity, a plate with a regime map, a domain box.
+fn busy_run(threads: usize) -> (TrackerState, (f64, f64)) {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| {
+        let field = AnalyticSet {
+            parts: vec![
+                AnalyticField::Uniform { velocity: Vec3::new(3.0, 0.0, -1.0) },
+                AnalyticField::LambOseen {
+                    circulation: 0.5,
+                    core_radius: 0.1,
+                    centre: Vec3::new(0.0, 0.0, 0.2),
+                    axis: Vec3::Y,
+                    nu: 0.0,
+                },
+            ],
+            turbulence: Some(ConstantTurbulence { k: 0.5, epsilon: 2.0 }),
+        };
+        let rule = WallRule::RegimeMap {
+            map: walls::tests_support::map(1.0),
+            bounce: Restitution { normal: 0.4, tangential: 0.9 },
+            max_tangential_speed: Some(3.0),
+            max_wall_shear: None,
+        };
+        let settings = TrackSettings {
+            dt: 2e-4,
+            domain: Some(Aabb::new(Vec3::new(-1.0, -1.0, -0.5), Vec3::new(1.0, 1.0, 1.0))),
+            dispersion: Some(DispersionSettings { seed: 42, ..Default::default() }),
+            max_bounces: 8,
+        };
+        let mut tr = Tracker::new(
+            field,
+            ForceModel::new(air(), ForceSwitches::default()),
+            settings,
+            vec![plate_body(rule)],
+        );
+        let mut rng = seeded(7, 0);
+        use spatter_core::rng::RngExt;
+        for _ in 0..3000 {
+            let x = Vec3::new(
+                rng.random::<f64>() - 0.6,
+                rng.random::<f64>() - 0.5,
+                0.3 + 0.3 * rng.random::<f64>(),
+            );
+            let d = 10e-6 + 90e-6 * rng.random::<f64>();
+            tr.add(
+                NewParcel {
+                    pos: x,
+                    vel: Vec3::ZERO,
+                    diameter: d,
+                    density: 917.0,
+                    count: 1.0 + 10.0 * rng.random::<f64>(),
+                },
+                0,
+            );
+        }
+        for _ in 0..1500 {
+            tr.step().unwrap();
+        }
+        let bal = tr.mass_balance();
+        (tr.state, bal)
+    })
+}
+
+#[test]
+fn results_do_not_depend_on_thread_count_and_mass_balance_is_exact() {
+    let (a, bal_a) = busy_run(1);
+    let (b, bal_b) = busy_run(2);
+    assert_eq!(a.parcels, b.parcels, "parcel states differ between 1 and 2 threads");
+    assert_eq!(a.deposits, b.deposits);
+    assert_eq!(bal_a.0.to_bits(), bal_b.0.to_bits());
+    // Every category happened.
+    let count = |s: Status| a.parcels.iter().filter(|p| p.status == s).count();
+    assert!(
+        count(Status::Deposited) > 0 && count(Status::Escaped) > 0 && count(Status::Airborne) > 0,
+        "{} {} {}",
+        count(Status::Deposited),
+        count(Status::Escaped),
+        count(Status::Airborne)
+    );
+    assert!(
+        a.deposits[0].impacts.iter().sum::<u64>() as usize > count(Status::Deposited),
+        "some parcels bounced"
+    );
+    // injected = deposited + escaped + airborne, bit for bit.
+    assert_eq!(bal_a.0.to_bits(), bal_a.1.to_bits(), "{} vs {}", bal_a.0, bal_a.1);
+    let b = &a.balance;
+    assert_eq!(
+        b.n_injected as usize,
+        b.n_deposited as usize + b.n_escaped as usize + count(Status::Airborne)
+    );
+    // The per-triangle deposit adds up to the deposited mass (to rounding).
+    let tri: f64 = a.deposits[0].mass.iter().sum();
+    assert!((tri - b.deposited.value()).abs() <= 1e-12 * tri);
+}
+
+/// e^(x²) erfc(x) for x ≥ 0.
+fn erfcx(x: f64) -> f64 {
+    (x * x).exp() * erfc(x)
+}
+
+#[test]
+fn basset_history_matches_the_analytic_solution() {
+    // Light sphere (ρ_p/ρ_f = ½) starting from rest in still fluid, Stokes drag, added mass C_A = ½ and
+    // the Basset force (C_H/6 = 1). In units τ_p and v_∞ = (1 − ρ_f/ρ_p) g τ_p:
+    // A dV/ds = 1 − V − B ∫ V′/√(s−σ) dσ, A = 1 + ½ρ_f/ρ_p = 2, B√π = 3 (B = 9/√(18π)·√(ρ_f/ρ_p)), so
+    // A p² + B√π p + 1 = 2(p + ½)(p + 1) and by Laplace transform
+    // V(s) = 1/(A(b−a)) [(1 − E(a))/a − (1 − E(b))/b], E(x) = e^(x²s) erfc(x√s), a = ½, b = 1.
+    // First-order scheme: error ∝ Δt; at Δt = τ_p/400 within 1 % of the final rise, and halving Δt
+    // roughly halves the error.
+    let fluid = Fluid { density: 1000.0, viscosity: 1e-3 };
+    let (d, rho) = (100e-6, 500.0);
+    let tau = stokes_time(&fluid, d, rho);
+    let v_inf = (1.0 - 1000.0 / 500.0) * (-9.81) * tau;
+    let exact = |s: f64| {
+        let (a, b, aa) = (0.5, 1.0, 2.0);
+        let e = |x: f64| erfcx(x * s.sqrt());
+        1.0 / (aa * (b - a)) * ((1.0 - e(a)) / a - (1.0 - e(b)) / b)
+    };
+    let run = |n_per_tau: usize| {
+        let sw = ForceSwitches {
+            drag: DragLaw::Stokes,
+            added_mass_coefficient: 0.5,
+            basset: Some(BassetSettings {
+                window: 4 * n_per_tau + 10,
+                odar_hamilton: false,
+                reeks_mckee: true,
+            }),
+            ..Default::default()
+        };
+        let mut tr = Tracker::new(
+            uniform(Vec3::ZERO),
+            ForceModel::new(fluid, sw),
+            TrackSettings { dt: tau / n_per_tau as f64, ..Default::default() },
+            vec![],
+        );
+        tr.add(one(Vec3::ZERO, Vec3::ZERO, d, rho), 0);
+        let mut out = Vec::new();
+        for k in 1..=4 * n_per_tau {
+            tr.step().unwrap();
+            if k % n_per_tau == 0 {
+                out.push(tr.state.parcels[0].vel.z / v_inf);
+            }
+        }
+        out
+    };
+    let coarse = run(200);
+    let fine = run(400);
+    for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
+        let s = (k + 1) as f64;
+        let ex = exact(s);
+        assert!((f - ex).abs() < 0.01, "s = {s}: {f} vs exact {ex}");
+        assert!((f - ex).abs() < 0.75 * (c - ex).abs() + 1e-4, "s = {s}: no convergence ({c}, {f}, {ex})");
+    }
+    // Without the history force the approach is exponential and much faster: V(4) = 1 − e^(−4/A).
+    assert!(exact(4.0) < 1.0 - (-2.0f64).exp());
+}
