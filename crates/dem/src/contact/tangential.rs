@@ -57,6 +57,7 @@ pub trait TangentialLaw: Clone + Debug + Send + Sync + 'static {
 #[allow(clippy::too_many_arguments)]
 fn spring_history(
     xi: &mut Vec3,
+    k_prev: &mut f64,
     k_t: f64,
     gamma_t: f64,
     mu: f64,
@@ -73,7 +74,8 @@ fn spring_history(
         // A history (almost) parallel to the new normal has no tangential meaning: drop it.
         x = if l2 > 1e-24 * len2 { x * (len2 / l2).sqrt() } else { Vec3::ZERO };
     }
-    let u_old = 0.5 * k_t * x.length_squared();
+    // Energy stored at the end of the previous step (with the stiffness of then).
+    let u_old = 0.5 * *k_prev * x.length_squared();
     x += v_t * dt;
     let mut f = -k_t * x - gamma_t * v_t;
     let cap = mu * f_coulomb;
@@ -83,8 +85,11 @@ fn spring_history(
         x = if k_t > 0.0 { -f / k_t } else { Vec3::ZERO };
     }
     *xi = x;
+    *k_prev = k_t;
     let energy = 0.5 * k_t * x.length_squared();
-    // Energy absorbed by the contact in this step minus the change of stored spring energy.
+    // Energy absorbed by the contact in this step minus the change of stored spring energy. A spring whose
+    // stiffness changes with the normal load (Mindlin) changes its stored energy without work; that change
+    // is counted here too, so mechanical + dissipated energy is conserved exactly by the bookkeeping.
     let dissipation = if dt > 0.0 { -f.dot(v_t) - (energy - u_old) / dt } else { 0.0 };
     TangentialForce { force: f, dissipation, energy }
 }
@@ -104,10 +109,12 @@ pub struct MindlinParams {
     pub mu: f64,
 }
 
-/// Tangential history state: the spring displacement ξ \[m\].
+/// Tangential history state: the spring displacement ξ \[m\] and the stiffness of the last step \[N/m\]
+/// (for the energy bookkeeping).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SpringHistory {
     pub xi: Vec3,
+    pub k_prev: f64,
 }
 
 impl TangentialLaw for Mindlin {
@@ -134,7 +141,7 @@ impl TangentialLaw for Mindlin {
         v_t: Vec3,
         c: &ContactInput,
     ) -> TangentialForce {
-        spring_history(&mut s.xi, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
+        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
     }
 }
 
@@ -175,7 +182,7 @@ impl TangentialLaw for LinearHistory {
         v_t: Vec3,
         c: &ContactInput,
     ) -> TangentialForce {
-        spring_history(&mut s.xi, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
+        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
     }
 }
 

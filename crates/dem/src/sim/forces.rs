@@ -1,0 +1,462 @@
+//! Force evaluation: gravity and external forces, wall contacts, pair contacts.
+
+use super::{ParticleView, Simulation};
+use crate::contact::{ContactInput, ContactLaw, ContactOutput};
+use crate::error::DemError;
+use crate::par::{run_groups, Group};
+use crate::walls::mesh::HitBuffer;
+use crate::walls::{WallHit, WallKinematics, WallShape};
+use rayon::prelude::*;
+use spatter_core::Vec3;
+
+/// What one wall-candidate slot did in the last evaluation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SlotOut {
+    /// In contact in the last evaluation.
+    pub active: bool,
+    /// The contact formed in the last evaluation.
+    pub formed: bool,
+    /// |F_n| \[N\].
+    pub normal_force: f64,
+    /// |F_t| \[N\].
+    pub tangential_force: f64,
+    /// Normal approach speed −v_rel·n \[m/s\].
+    pub approach_speed: f64,
+    /// Contact force on the particle \[N\] (the wall gets the opposite).
+    pub force: Vec3,
+}
+
+/// Per-task reduction of one evaluation.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Acc {
+    pub dissipation: f64,
+    pub elastic: f64,
+    pub wall_power: f64,
+    pub pair_contacts: u64,
+    pub wall_contacts: u64,
+    pub max_ratio: f64,
+    /// Ids of the pair with the largest overlap ratio (`u32::MAX` as second id for a wall).
+    pub worst: (u32, u32),
+}
+
+impl Acc {
+    fn combine(a: Acc, b: Acc) -> Acc {
+        let (max_ratio, worst) =
+            if b.max_ratio > a.max_ratio { (b.max_ratio, b.worst) } else { (a.max_ratio, a.worst) };
+        Acc {
+            dissipation: a.dissipation + b.dissipation,
+            elastic: a.elastic + b.elastic,
+            wall_power: a.wall_power + b.wall_power,
+            pair_contacts: a.pair_contacts + b.pair_contacts,
+            wall_contacts: a.wall_contacts + b.wall_contacts,
+            max_ratio,
+            worst,
+        }
+    }
+
+    #[inline]
+    fn note_overlap(&mut self, ratio: f64, a: u32, b: u32) {
+        if ratio > self.max_ratio || ratio.is_nan() {
+            self.max_ratio = if ratio.is_nan() { f64::INFINITY } else { ratio };
+            self.worst = (a, b);
+        }
+    }
+}
+
+impl<L: ContactLaw> Simulation<L> {
+    /// Computes forces and torques at the current state, updates contact states, energy accounts and mesh
+    /// records.
+    pub(crate) fn compute_forces(&mut self) {
+        let t = self.st.time;
+        let dt = self.dt;
+        self.scratch.kin.clear();
+        self.scratch.kin.extend(self.walls.iter().map(|w| WallKinematics::of(&w.motion, t)));
+        let g = self.gravity;
+        let n = self.particles.len();
+
+        // Gravity and persistent external forces.
+        {
+            let p = &mut self.particles;
+            let has_ext = !p.ext_force.is_empty();
+            let (ext_f, ext_t) = (&p.ext_force, &p.ext_torque);
+            p.force.par_iter_mut().zip(p.torque.par_iter_mut()).enumerate().for_each(|(i, (f, tq))| {
+                let m = p.mass[i];
+                *f = if p.inv_mass[i] > 0.0 { m * g } else { Vec3::ZERO };
+                *tq = Vec3::ZERO;
+                if has_ext {
+                    *f += ext_f[i];
+                    *tq += ext_t[i];
+                }
+            });
+        }
+        // External work uses the velocities at evaluation time (half-step velocities under Verlet).
+        let mut ext_power = 0.0;
+        if !self.particles.ext_force.is_empty() {
+            let p = &self.particles;
+            ext_power += (0..n)
+                .filter(|&i| p.inv_mass[i] > 0.0)
+                .map(|i| p.ext_force[i].dot(p.vel[i]) + p.ext_torque[i].dot(p.omega[i]))
+                .sum::<f64>();
+        }
+        if let Some(ext) = self.external.as_mut() {
+            let p = &mut self.particles;
+            let (bf, bt) = (&mut self.scratch.ext_force, &mut self.scratch.ext_torque);
+            bf.clear();
+            bf.resize(n, Vec3::ZERO);
+            bt.clear();
+            bt.resize(n, Vec3::ZERO);
+            let view = ParticleView {
+                id: &p.id,
+                material: &p.material,
+                pos: &p.pos,
+                vel: &p.vel,
+                omega: &p.omega,
+                radius: &p.radius,
+                mass: &p.mass,
+            };
+            ext.add(t, &view, bf, bt);
+            for i in 0..n {
+                if p.inv_mass[i] > 0.0 {
+                    p.force[i] += bf[i];
+                    p.torque[i] += bt[i];
+                    ext_power += bf[i].dot(p.vel[i]) + bt[i].dot(p.omega[i]);
+                }
+            }
+        }
+
+        let law = &self.law;
+        let params = &self.params;
+        let walls = &self.walls;
+        let kin = &self.scratch.kin;
+        let crate::particles::Particles {
+            id,
+            material,
+            pos,
+            vel,
+            omega,
+            radius,
+            mass,
+            inv_mass,
+            inv_inertia,
+            force,
+            torque,
+            ..
+        } = &mut self.particles;
+        let (id, material, pos, vel, omega, radius, mass, inv_mass, inv_inertia) =
+            (&*id, &*material, &*pos, &*vel, &*omega, &*radius, &*mass, &*inv_mass, &*inv_inertia);
+        let default = L::State::default();
+
+        // Wall contacts: each particle owns its slots.
+        let wl = &mut self.st.wall_list;
+        let (w_start, w_wall, w_tri) = (&wl.start, &wl.wall, &wl.tri);
+        let wall_work = |g: &Group,
+                         pbase: usize,
+                         (f, tq): (&mut [Vec3], &mut [Vec3]),
+                         sbase: usize,
+                         (states, outs): (&mut [L::State], &mut [SlotOut])| {
+            let mut acc = Acc::default();
+            let mut raw = HitBuffer::default();
+            let mut hits = HitBuffer::default();
+            for i in g.work_begin as usize..g.work_end as usize {
+                let (k0, k1) = (w_start[i] as usize, w_start[i + 1] as usize);
+                let mut k = k0;
+                while k < k1 {
+                    let w = w_wall[k] as usize;
+                    let mut e = k + 1;
+                    while e < k1 && w_wall[e] as usize == w {
+                        e += 1;
+                    }
+                    let wall = &walls[w];
+                    let kw = &kin[w];
+                    let pp = params.get(material[i] as usize, wall.material as usize);
+                    let r = radius[i];
+                    let reach = r + law.range(pp, r);
+                    let x_ref = kw.to_reference(pos[i]);
+                    let mut contact =
+                        |hit: WallHit, state: &mut L::State, out: &mut SlotOut, acc: &mut Acc| {
+                            let n = hit.normal;
+                            let v_wall = kw.velocity_at(hit.point);
+                            let c = ContactInput {
+                                normal: n,
+                                overlap: r - hit.distance,
+                                r_eff: r,
+                                m_eff: mass[i],
+                                i_eff: 0.4 * mass[i] * r * r,
+                                v_rel: vel[i] - r * omega[i].cross(n) - v_wall,
+                                w_rel: omega[i] - kw.omega,
+                                dt,
+                            };
+                            let was_new = *state == default;
+                            match law.compute(pp, &c, state) {
+                                None => {
+                                    *state = default;
+                                    *out = SlotOut::default();
+                                }
+                                Some(o) => {
+                                    apply_wall(&o, n, r, i - pbase, f, tq);
+                                    acc.dissipation += o.dissipation;
+                                    acc.elastic += o.energy;
+                                    acc.wall_power += o.force.dot(v_wall) + o.rolling_torque.dot(kw.omega);
+                                    acc.wall_contacts += 1;
+                                    acc.note_overlap(c.overlap / r, id[i], u32::MAX);
+                                    *out = SlotOut {
+                                        active: true,
+                                        formed: was_new,
+                                        normal_force: o.normal_force.abs(),
+                                        tangential_force: o.tangential_force(n).length(),
+                                        approach_speed: -c.v_rel.dot(n),
+                                        force: o.force,
+                                    };
+                                }
+                            }
+                        };
+                    match &wall.shape {
+                        WallShape::Mesh(m) => {
+                            m.resolve(x_ref, reach, &w_tri[k..e], &mut raw, &mut hits);
+                            let hs = hits.as_slice();
+                            let accepted = |s: usize| hs.iter().any(|h| k + h.slot == s);
+                            // A contact that moved onto a neighbouring triangle inherits the state of
+                            // the nearest contact of this mesh that ended.
+                            for h in hs {
+                                let s = k + h.slot;
+                                if states[s - sbase] != default {
+                                    continue;
+                                }
+                                let mut best: Option<(f64, usize)> = None;
+                                for s2 in k..e {
+                                    if accepted(s2) || states[s2 - sbase] == default {
+                                        continue;
+                                    }
+                                    let [a, b, c] = m.mesh.corners(w_tri[s2] as usize);
+                                    let (q, _) =
+                                        spatter_core::mesh::closest_point_on_triangle(h.point, a, b, c);
+                                    let d = (q - h.point).length_squared();
+                                    if best.is_none_or(|(bd, _)| d < bd) {
+                                        best = Some((d, s2));
+                                    }
+                                }
+                                if let Some((_, s2)) = best {
+                                    states[s - sbase] = states[s2 - sbase];
+                                    states[s2 - sbase] = default;
+                                }
+                            }
+                            for s in k..e {
+                                if !accepted(s) {
+                                    states[s - sbase] = default;
+                                    outs[s - sbase] = SlotOut::default();
+                                }
+                            }
+                            for h in hs {
+                                let hit = kw.hit_to_world(h.point, h.normal, h.distance);
+                                let s = k + h.slot - sbase;
+                                contact(hit, &mut states[s], &mut outs[s], &mut acc);
+                            }
+                        }
+                        _ => {
+                            for s in k..e {
+                                match wall.analytic_hit(x_ref, reach) {
+                                    Some((q, nrm, d)) => contact(
+                                        kw.hit_to_world(q, nrm, d),
+                                        &mut states[s - sbase],
+                                        &mut outs[s - sbase],
+                                        &mut acc,
+                                    ),
+                                    None => {
+                                        states[s - sbase] = default;
+                                        outs[s - sbase] = SlotOut::default();
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    k = e;
+                }
+            }
+            acc
+        };
+        let acc_w = run_groups(
+            &wl.blocks,
+            0,
+            (&mut force[..], &mut torque[..]),
+            0,
+            (&mut wl.state[..], &mut wl.out[..]),
+            &wl.start,
+            &wall_work,
+            &Acc::combine,
+        )
+        .unwrap_or_default();
+
+        // Pair contacts over the half list, in two colouring phases.
+        let list = &mut self.st.list;
+        let (l_start, l_nbr) = (&list.start, &list.nbr);
+        let range_quick = {
+            let r_max = self.st.r_max;
+            let nmat = params.types();
+            let mut m: f64 = 0.0;
+            for a in 0..nmat {
+                for b in 0..nmat {
+                    m = m.max(law.range(params.get(a, b), 0.5 * r_max));
+                }
+            }
+            m
+        };
+        let pair_work = |g: &Group,
+                         pbase: usize,
+                         (f, tq): (&mut [Vec3], &mut [Vec3]),
+                         sbase: usize,
+                         states: &mut [L::State]| {
+            let mut acc = Acc::default();
+            for i in g.work_begin as usize..g.work_end as usize {
+                for k in l_start[i] as usize..l_start[i + 1] as usize {
+                    let j = l_nbr[k] as usize;
+                    let state = &mut states[k - sbase];
+                    // Orientation by id keeps each state in the lower-id particle's frame.
+                    let (a, b) = if id[i] < id[j] { (i, j) } else { (j, i) };
+                    let d = pos[a] - pos[b];
+                    let (ra, rb) = (radius[a], radius[b]);
+                    let rs = ra + rb;
+                    let reach = rs + range_quick;
+                    let dist2 = d.length_squared();
+                    if dist2 >= reach * reach {
+                        if *state != default {
+                            *state = default;
+                        }
+                        continue;
+                    }
+                    let dist = dist2.sqrt();
+                    let n = if dist > 0.0 { d / dist } else { Vec3::Z };
+                    let inv = inv_mass[a] + inv_mass[b];
+                    let inv_i = inv_inertia[a] + inv_inertia[b];
+                    let c = ContactInput {
+                        normal: n,
+                        overlap: rs - dist,
+                        r_eff: ra * rb / rs,
+                        m_eff: 1.0 / inv,
+                        i_eff: 1.0 / inv_i,
+                        v_rel: vel[a] - vel[b] - (ra * omega[a] + rb * omega[b]).cross(n),
+                        w_rel: omega[a] - omega[b],
+                        dt,
+                    };
+                    let pp = params.get(material[a] as usize, material[b] as usize);
+                    match law.compute(pp, &c, state) {
+                        None => *state = default,
+                        Some(o) => {
+                            let fv = o.force;
+                            let cr = n.cross(fv);
+                            f[a - pbase] += fv;
+                            f[b - pbase] -= fv;
+                            tq[a - pbase] += o.rolling_torque - ra * cr;
+                            tq[b - pbase] += -o.rolling_torque - rb * cr;
+                            acc.dissipation += o.dissipation;
+                            acc.elastic += o.energy;
+                            acc.pair_contacts += 1;
+                            acc.note_overlap(c.overlap / ra.min(rb), id[a], id[b]);
+                        }
+                    }
+                }
+            }
+            acc
+        };
+        let mut acc = acc_w;
+        for phase in 0..2 {
+            let a = run_groups(
+                &list.phases[phase],
+                0,
+                (&mut force[..], &mut torque[..]),
+                0,
+                &mut list.state[..],
+                l_start,
+                &pair_work,
+                &Acc::combine,
+            )
+            .unwrap_or_default();
+            acc = Acc::combine(acc, a);
+        }
+
+        // Mesh impact records (sequential: slots of different particles share triangles).
+        let wl = &self.st.wall_list;
+        for k in 0..wl.out.len() {
+            let o = wl.out[k];
+            if !o.active {
+                continue;
+            }
+            if let WallShape::Mesh(m) = &mut self.walls[wl.wall[k] as usize].shape {
+                let t = wl.tri[k] as usize;
+                let r = &mut m.records;
+                r.normal_impulse[t] += o.normal_force * dt;
+                r.tangential_impulse[t] += o.tangential_force * dt;
+                if o.formed {
+                    r.impacts[t] += 1;
+                    r.impact_speed_sum[t] += o.approach_speed;
+                }
+            }
+        }
+
+        let e = &mut self.st.energy;
+        e.dissipated += acc.dissipation * dt;
+        e.wall_work += acc.wall_power * dt;
+        e.external_work += ext_power * dt;
+        self.st.last = super::LastEvaluation {
+            elastic: acc.elastic,
+            pair_contacts: acc.pair_contacts,
+            wall_contacts: acc.wall_contacts,
+            max_overlap_ratio: acc.max_ratio,
+        };
+        self.last_worst = acc.worst;
+    }
+
+    /// Total contact force exerted by the particles on wall `w` in the last evaluation \[N\].
+    pub fn wall_force(&self, w: usize) -> Vec3 {
+        let wl = &self.st.wall_list;
+        let mut f = Vec3::ZERO;
+        for k in 0..wl.out.len() {
+            if wl.out[k].active && wl.wall[k] as usize == w {
+                f -= wl.out[k].force;
+            }
+        }
+        f
+    }
+
+    /// The blow-up error for an excessive overlap found in the last evaluation.
+    pub(crate) fn blow_up_overlap(&self) -> DemError {
+        let (a, b) = self.last_worst;
+        let ratio = self.st.last.max_overlap_ratio;
+        let what = if b == u32::MAX {
+            format!("overlap with a wall is {:.3} of its radius", ratio)
+        } else {
+            format!("overlap with particle id {b} is {:.3} of the smaller radius", ratio)
+        };
+        DemError::BlowUp {
+            particle: a,
+            step: self.st.step,
+            time_s: self.st.time,
+            what: format!("{what} (limit {})", self.settings.max_overlap_fraction),
+            cause: self.likely_cause(),
+        }
+    }
+
+    /// A sentence on what most likely went wrong.
+    pub(crate) fn likely_cause(&self) -> String {
+        let tr = self.rayleigh_time();
+        if self.dt > 0.3 * tr {
+            format!(
+                "the time step dt = {:e} s is {:.2} of the Rayleigh time {:e} s; use dt ≤ 0.2 × Rayleigh time",
+                self.dt,
+                self.dt / tr,
+                tr
+            )
+        } else if self.st.step < 5 {
+            "particles were created overlapping (check insertion regions, lattice spacing and radii)".into()
+        } else {
+            "an impact too fast or a material too soft for this time step (reduce dt_s or check speeds, \
+             moduli and wall motion)"
+                .into()
+        }
+    }
+}
+
+#[inline]
+fn apply_wall(o: &ContactOutput, n: Vec3, r: f64, i: usize, f: &mut [Vec3], tq: &mut [Vec3]) {
+    f[i] += o.force;
+    tq[i] += o.rolling_torque - r * n.cross(o.force);
+}

@@ -1,0 +1,502 @@
+//! The DEM simulation: particles, walls, contact law, neighbour lists and time integration.
+//!
+//! [`Simulation<L>`] is generic over its [`ContactLaw`]; the per-contact code is monomorphised for `L`.
+//!
+//! One step (velocity Verlet, the default):
+//!
+//! 1. half kick v += ½Δt F/m, ω += ½Δt τ/I, drift x += v Δt (parallel over particles);
+//! 2. rebuild the neighbour and wall-candidate lists if particles may have moved more than half the skin
+//!    (the bound is the running sum of the largest speed times Δt: no per-particle reference positions
+//!    are stored); a rebuild re-sorts the particle arrays by cell and carries every contact state over by
+//!    the particles' stable ids;
+//! 3. forces: gravity + external, wall contacts (parallel over particle blocks), pair contacts over the
+//!    half list in two colouring phases (see [`crate::par`]); energies and the largest overlap are
+//!    reduced in a fixed tree, so results are identical for any thread count;
+//! 4. second half kick.
+//!
+//! Symplectic Euler evaluates the forces first, then kicks by a full step and drifts.
+
+mod forces;
+mod integrate;
+mod neighbors;
+
+pub use integrate::Integrator;
+pub use neighbors::{PairList, WallList};
+
+use crate::contact::{ContactLaw, PairProps, PairTable};
+use crate::error::DemError;
+use crate::particles::{NewParticle, Particles, PermuteScratch};
+use crate::walls::{Wall, WallKinematics, WallShape};
+use serde::{Deserialize, Serialize};
+use spatter_core::grid::CellGrid;
+use spatter_core::material::Material;
+use spatter_core::{Aabb, Vec3};
+
+/// Engine options.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub integrator: Integrator,
+    /// Verlet skin \[m\]; `None` = 10 % of the largest particle diameter.
+    pub skin: Option<f64>,
+    /// Keep a Verlet list between rebuilds (true) or rebuild the cell search every step (false; for
+    /// comparison).
+    pub verlet_list: bool,
+    /// Blow-up when an overlap exceeds this fraction of the smaller radius (default 0.25).
+    pub max_overlap_fraction: f64,
+    /// Particles whose centre leaves this box are removed and counted (none by default).
+    pub domain: Option<Aabb>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            integrator: Integrator::VelocityVerlet,
+            skin: None,
+            verlet_list: true,
+            max_overlap_fraction: 0.25,
+            domain: None,
+        }
+    }
+}
+
+/// Energy accounts integrated over the run \[J\].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyAccounts {
+    /// Work dissipated by dashpots, Coulomb slip and rolling resistance.
+    pub dissipated: f64,
+    /// Work done on the particles by external forces (including the external-force hook).
+    pub external_work: f64,
+    /// Work done on the particles by moving walls.
+    pub wall_work: f64,
+}
+
+/// Results of the last force evaluation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LastEvaluation {
+    /// Elastic energy stored in contacts \[J\].
+    pub elastic: f64,
+    /// Particle–particle contacts.
+    pub pair_contacts: u64,
+    /// Particle–wall contacts.
+    pub wall_contacts: u64,
+    /// Largest overlap divided by the smaller radius.
+    pub max_overlap_ratio: f64,
+}
+
+/// The energy budget at one instant.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyReport {
+    pub time: f64,
+    /// Σ ½ m v² \[J\].
+    pub kinetic: f64,
+    /// Σ ½ I ω² \[J\].
+    pub rotational: f64,
+    /// Elastic energy in contacts \[J\].
+    pub elastic: f64,
+    /// Gravitational potential Σ −m g·x \[J\].
+    pub potential: f64,
+    /// Accumulated dissipation \[J\].
+    pub dissipated: f64,
+    /// Accumulated work of external forces \[J\].
+    pub external_work: f64,
+    /// Accumulated work of moving walls \[J\].
+    pub wall_work: f64,
+    pub pair_contacts: u64,
+    pub wall_contacts: u64,
+}
+
+impl EnergyReport {
+    /// Mechanical energy KE + rotational + elastic + potential \[J\].
+    pub fn mechanical(&self) -> f64 {
+        self.kinetic + self.rotational + self.elastic + self.potential
+    }
+
+    /// The conserved total: mechanical + dissipated − work put in by external forces and walls \[J\].
+    pub fn total(&self) -> f64 {
+        self.mechanical() + self.dissipated - self.external_work - self.wall_work
+    }
+}
+
+/// Everything that evolves during a run besides the particle arrays; checkpointed with them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DynState<S> {
+    pub time: f64,
+    pub step: u64,
+    pub energy: EnergyAccounts,
+    pub last: LastEvaluation,
+    /// Forces in the particle arrays belong to the current positions (velocity Verlet needs them).
+    pub forces_valid: bool,
+    /// Bound on the largest particle displacement since the last rebuild \[m\].
+    pub disp_particles: f64,
+    /// Bound on the largest wall displacement since the last rebuild \[m\].
+    pub disp_walls: f64,
+    pub needs_rebuild: bool,
+    pub rebuilds: u64,
+    /// Particles removed for leaving the domain.
+    pub removed: u64,
+    pub list: PairList<S>,
+    pub wall_list: WallList<S>,
+    /// Largest particle radius seen \[m\].
+    pub r_max: f64,
+}
+
+impl<S> Default for DynState<S> {
+    fn default() -> Self {
+        DynState {
+            time: 0.0,
+            step: 0,
+            energy: EnergyAccounts::default(),
+            last: LastEvaluation::default(),
+            forces_valid: false,
+            disp_particles: 0.0,
+            disp_walls: 0.0,
+            needs_rebuild: true,
+            rebuilds: 0,
+            removed: 0,
+            list: PairList::default(),
+            wall_list: WallList::default(),
+            r_max: 0.0,
+        }
+    }
+}
+
+/// Read-only view of the particle arrays for the external-force hook.
+#[derive(Clone, Copy, Debug)]
+pub struct ParticleView<'a> {
+    pub id: &'a [u32],
+    pub material: &'a [u16],
+    pub pos: &'a [Vec3],
+    pub vel: &'a [Vec3],
+    pub omega: &'a [Vec3],
+    pub radius: &'a [f64],
+    pub mass: &'a [f64],
+}
+
+/// Forces computed outside the engine (fluid drag, fields), called once per force evaluation. Add into
+/// `force`/`torque` (indexed like the view; the arrays come zeroed). Must be deterministic for
+/// reproducible runs.
+pub trait ExternalForces: Send + Sync {
+    fn add(&mut self, time: f64, particles: &ParticleView, force: &mut [Vec3], torque: &mut [Vec3]);
+}
+
+#[derive(Default)]
+struct Scratch {
+    grid: CellGrid,
+    perm: Vec<u32>,
+    permute: PermuteScratch,
+    kin: Vec<WallKinematics>,
+    ext_force: Vec<Vec3>,
+    ext_torque: Vec<Vec3>,
+}
+
+/// Pair properties for every pair of `materials` with one friction coefficient μ and restitution e.
+pub fn uniform_pairs(materials: &[Material], friction: f64, restitution: f64) -> PairTable<PairProps> {
+    PairTable::build(materials.len(), |a, b| {
+        PairProps::new(&materials[a], &materials[b], friction, restitution)
+    })
+}
+
+/// A DEM simulation with contact law `L`.
+pub struct Simulation<L: ContactLaw> {
+    pub law: L,
+    materials: Vec<Material>,
+    props: PairTable<PairProps>,
+    params: PairTable<L::Params>,
+    pub particles: Particles,
+    pub walls: Vec<Wall>,
+    /// Gravitational acceleration \[m/s²\].
+    pub gravity: Vec3,
+    /// Time step \[s\].
+    pub dt: f64,
+    pub settings: Settings,
+    pub(crate) st: DynState<L::State>,
+    scratch: Scratch,
+    external: Option<Box<dyn ExternalForces>>,
+    /// Ids of the pair with the largest overlap in the last evaluation (second = `u32::MAX` for a wall).
+    last_worst: (u32, u32),
+}
+
+impl<L: ContactLaw> Simulation<L> {
+    /// A simulation with `materials` (indexed by particle and wall material ids), pair properties for
+    /// every material pair, and time step `dt` \[s\].
+    pub fn new(
+        law: L,
+        materials: Vec<Material>,
+        props: PairTable<PairProps>,
+        dt: f64,
+        settings: Settings,
+    ) -> Self {
+        assert_eq!(props.types(), materials.len(), "one pair-table row per material");
+        let params = props.map(|k, p| law.params(k, p));
+        Simulation {
+            law,
+            materials,
+            props,
+            params,
+            particles: Particles::new(),
+            walls: Vec::new(),
+            gravity: Vec3::ZERO,
+            dt,
+            settings,
+            st: DynState::default(),
+            scratch: Scratch::default(),
+            external: None,
+            last_worst: (0, 0),
+        }
+    }
+
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Pair properties of materials (a, b).
+    pub fn pair_props(&self, a: usize, b: usize) -> &PairProps {
+        self.props.get(a, b)
+    }
+
+    /// Precomputed contact-law parameters of materials (a, b).
+    pub fn pair_params(&self, a: usize, b: usize) -> &L::Params {
+        self.params.get(a, b)
+    }
+
+    /// Current time \[s\].
+    pub fn time(&self) -> f64 {
+        self.st.time
+    }
+
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.st.step
+    }
+
+    /// Neighbour-list rebuilds so far.
+    pub fn rebuild_count(&self) -> u64 {
+        self.st.rebuilds
+    }
+
+    /// Particles removed for leaving the domain.
+    pub fn removed_count(&self) -> u64 {
+        self.st.removed
+    }
+
+    /// Results of the last force evaluation.
+    pub fn last_evaluation(&self) -> &LastEvaluation {
+        &self.st.last
+    }
+
+    pub fn energy_accounts(&self) -> &EnergyAccounts {
+        &self.st.energy
+    }
+
+    /// Adds a particle (material `p.material` must exist); returns its id.
+    pub fn add_particle(&mut self, p: NewParticle) -> u32 {
+        let rho = self.materials[p.material as usize].density;
+        self.st.r_max = self.st.r_max.max(p.radius);
+        self.st.needs_rebuild = true;
+        self.st.forces_valid = false;
+        self.particles.push(p, rho)
+    }
+
+    /// Adds a wall; returns its index.
+    pub fn add_wall(&mut self, w: Wall) -> usize {
+        assert!((w.material as usize) < self.materials.len(), "wall material index out of range");
+        self.walls.push(w);
+        self.st.needs_rebuild = true;
+        self.st.forces_valid = false;
+        self.walls.len() - 1
+    }
+
+    /// Installs the external-force hook.
+    pub fn set_external_forces(&mut self, f: Box<dyn ExternalForces>) {
+        self.external = Some(f);
+        self.st.forces_valid = false;
+    }
+
+    /// Marks the neighbour lists as stale (after editing particles directly).
+    pub fn invalidate(&mut self) {
+        self.st.needs_rebuild = true;
+        self.st.forces_valid = false;
+        self.st.r_max = self.particles.radius.iter().copied().fold(0.0, f64::max);
+    }
+
+    /// The Verlet skin in use \[m\].
+    pub fn skin(&self) -> f64 {
+        if !self.settings.verlet_list {
+            return 0.0;
+        }
+        self.settings.skin.unwrap_or(0.2 * self.st.r_max)
+    }
+
+    /// Largest interaction range beyond touching over all particle pairs and particle–wall pairs \[m\].
+    fn range_max(&self, r: f64) -> (f64, f64) {
+        let n = self.materials.len();
+        let mut pp: f64 = 0.0;
+        for a in 0..n {
+            for b in 0..n {
+                pp = pp.max(self.law.range(self.params.get(a, b), 0.5 * r));
+            }
+        }
+        let mut pw: f64 = 0.0;
+        for w in &self.walls {
+            for a in 0..n {
+                pw = pw.max(self.law.range(self.params.get(a, w.material as usize), r));
+            }
+        }
+        (pp, pw)
+    }
+
+    /// Advances one time step.
+    pub fn step(&mut self) -> Result<(), DemError> {
+        if self.dt <= 0.0 || !self.dt.is_finite() {
+            return Err(DemError::Config {
+                key: "dt_s".into(),
+                message: format!("dt_s = {} must be a positive number of seconds", self.dt),
+            });
+        }
+        match self.settings.integrator {
+            Integrator::VelocityVerlet => {
+                if self.st.needs_rebuild {
+                    self.rebuild();
+                }
+                if !self.st.forces_valid {
+                    self.evaluate()?;
+                }
+                let vmax = self.kick_drift(0.5, true);
+                self.advance_time(vmax);
+                self.maybe_rebuild();
+                self.evaluate()?;
+                self.kick_drift(0.5, false);
+            }
+            Integrator::SymplecticEuler => {
+                if self.st.needs_rebuild {
+                    self.rebuild();
+                }
+                self.evaluate()?;
+                let vmax = self.kick_drift(1.0, true);
+                self.advance_time(vmax);
+                self.maybe_rebuild();
+                // Forces now belong to the previous positions.
+                self.st.forces_valid = false;
+            }
+        }
+        self.st.step += 1;
+        self.check_finite()
+    }
+
+    /// Advances `n` steps.
+    pub fn run_steps(&mut self, n: u64) -> Result<(), DemError> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn advance_time(&mut self, vmax: f64) {
+        self.st.time += self.dt;
+        self.st.disp_particles += vmax * self.dt;
+        let t = self.st.time;
+        let mut wmax: f64 = 0.0;
+        for w in &self.walls {
+            if !matches!(w.motion, spatter_core::motion::Motion::Fixed) {
+                let k = WallKinematics::of(&w.motion, t);
+                wmax = wmax.max(k.max_speed(w.extent(0.0)));
+            }
+        }
+        self.st.disp_walls += wmax * self.dt;
+    }
+
+    fn maybe_rebuild(&mut self) {
+        let skin = self.skin();
+        let dp = self.st.disp_particles;
+        let dw = self.st.disp_walls;
+        if self.st.needs_rebuild || !self.settings.verlet_list || (2.0 * dp).max(dp + dw) > skin {
+            self.rebuild();
+        }
+    }
+
+    /// Evaluates forces at the current state and checks for blow-up.
+    fn evaluate(&mut self) -> Result<(), DemError> {
+        self.compute_forces();
+        self.st.forces_valid = true;
+        if self.st.last.max_overlap_ratio > self.settings.max_overlap_fraction {
+            return Err(self.blow_up_overlap());
+        }
+        Ok(())
+    }
+
+    /// The energy budget now (kinetic energies use the current, full-step velocities).
+    pub fn energy(&self) -> EnergyReport {
+        let p = &self.particles;
+        let mut ke = 0.0;
+        let mut rot = 0.0;
+        let mut pot = 0.0;
+        for i in 0..p.len() {
+            if p.inv_mass[i] == 0.0 {
+                continue;
+            }
+            ke += 0.5 * p.mass[i] * p.vel[i].length_squared();
+            rot += 0.5 * p.inertia(i) * p.omega[i].length_squared();
+            pot -= p.mass[i] * self.gravity.dot(p.pos[i]);
+        }
+        EnergyReport {
+            time: self.st.time,
+            kinetic: ke,
+            rotational: rot,
+            elastic: self.st.last.elastic,
+            potential: pot,
+            dissipated: self.st.energy.dissipated,
+            external_work: self.st.energy.external_work,
+            wall_work: self.st.energy.wall_work,
+            pair_contacts: self.st.last.pair_contacts,
+            wall_contacts: self.st.last.wall_contacts,
+        }
+    }
+
+    /// Smallest Rayleigh time step over the particle materials and radii present \[s\].
+    pub fn rayleigh_time(&self) -> f64 {
+        let p = &self.particles;
+        let mut t = f64::INFINITY;
+        for i in 0..p.len() {
+            let m = &self.materials[p.material[i] as usize];
+            if m.youngs_modulus.is_finite() {
+                t = t.min(spatter_core::timestep::rayleigh_time(
+                    p.radius[i],
+                    m.density,
+                    m.shear_modulus(),
+                    m.poisson_ratio,
+                ));
+            }
+        }
+        t
+    }
+
+    /// Bytes of simulation state per particle: particle arrays, pair list with contact states, wall
+    /// candidates, neighbour-search grid.
+    pub fn bytes_per_particle(&self) -> f64 {
+        let n = self.particles.len().max(1) as f64;
+        let s = std::mem::size_of::<L::State>();
+        let list = &self.st.list;
+        let wl = &self.st.wall_list;
+        let pairs = list.nbr.capacity() * 4 + list.state.capacity() * s + list.start.capacity() * 4;
+        let walls = wl.start.capacity() * 4
+            + wl.wall.capacity() * 2
+            + wl.tri.capacity() * 4
+            + wl.state.capacity() * s
+            + wl.out.capacity() * std::mem::size_of::<forces::SlotOut>();
+        let grid = 3 * 4 * self.particles.len();
+        self.particles.bytes_per_particle() as f64 + (pairs + walls + grid) as f64 / n
+    }
+
+    /// Number of pairs in the neighbour list.
+    pub fn pair_list_len(&self) -> usize {
+        self.st.list.nbr.len()
+    }
+
+    /// Whether wall `w` is a mesh.
+    pub fn is_mesh_wall(&self, w: usize) -> bool {
+        matches!(self.walls[w].shape, WallShape::Mesh(_))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,271 @@
+//! Neighbour and wall-candidate lists: rebuilt with a skin, particles re-sorted by cell at every rebuild,
+//! contact states carried over by stable ids.
+
+use super::forces::SlotOut;
+use super::Simulation;
+use crate::contact::ContactLaw;
+use crate::par::{blocks, colour_phases, Group};
+use crate::walls::{WallKinematics, WallShape};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Half neighbour list in CSR form: the partners j > i of particle i are `nbr[start[i]..start[i+1]]`,
+/// with one contact state each (from the lower-id particle's point of view).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PairList<S> {
+    pub start: Vec<u32>,
+    pub nbr: Vec<u32>,
+    pub state: Vec<S>,
+    /// The two colouring phases of groups (see [`crate::par::colour_phases`]).
+    pub phases: [Vec<Group>; 2],
+}
+
+impl<S> Default for PairList<S> {
+    fn default() -> Self {
+        PairList { start: vec![0], nbr: Vec::new(), state: Vec::new(), phases: [Vec::new(), Vec::new()] }
+    }
+}
+
+/// Wall candidates per particle in CSR form: slots `start[i]..start[i+1]`, sorted by (wall, triangle).
+/// Analytic walls use triangle 0.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WallList<S> {
+    pub start: Vec<u32>,
+    pub wall: Vec<u16>,
+    pub tri: Vec<u32>,
+    pub state: Vec<S>,
+    /// What each slot did in the last evaluation (not checkpointed; rebuilt on load).
+    #[serde(skip)]
+    pub out: Vec<SlotOut>,
+    /// Particle blocks for the parallel wall loop.
+    pub blocks: Vec<Group>,
+}
+
+impl<S> Default for WallList<S> {
+    fn default() -> Self {
+        WallList {
+            start: vec![0],
+            wall: Vec::new(),
+            tri: Vec::new(),
+            state: Vec::new(),
+            out: Vec::new(),
+            blocks: Vec::new(),
+        }
+    }
+}
+
+const BLOCK: usize = 1024;
+
+impl<L: ContactLaw> Simulation<L> {
+    /// Rebuilds the neighbour and wall lists: removes particles outside the domain, sorts the particle
+    /// arrays by cell, builds the half list and the wall candidates, and restores every contact state.
+    pub(crate) fn rebuild(&mut self) {
+        let default = L::State::default();
+        // 1. Carry the active states, keyed by ids.
+        let mut carry: Vec<(u64, L::State)> = Vec::new();
+        {
+            let p = &self.particles;
+            let l = &self.st.list;
+            if l.start.len() == p.len() + 1 {
+                for i in 0..p.len() {
+                    for k in l.start[i] as usize..l.start[i + 1] as usize {
+                        if l.state[k] != default {
+                            let (a, b) = (p.id[i], p.id[l.nbr[k] as usize]);
+                            carry.push((pair_key(a, b), l.state[k]));
+                        }
+                    }
+                }
+            }
+        }
+        carry.sort_unstable_by_key(|c| c.0);
+        let mut wall_carry: Vec<((u32, u16, u32), L::State)> = Vec::new();
+        {
+            let p = &self.particles;
+            let wl = &self.st.wall_list;
+            if wl.start.len() == p.len() + 1 {
+                for i in 0..p.len() {
+                    for k in wl.start[i] as usize..wl.start[i + 1] as usize {
+                        if wl.state[k] != default {
+                            wall_carry.push(((p.id[i], wl.wall[k], wl.tri[k]), wl.state[k]));
+                        }
+                    }
+                }
+            }
+        }
+        wall_carry.sort_unstable_by_key(|c| c.0);
+
+        // 2. Domain: drop particles that left it.
+        if let Some(dom) = self.settings.domain {
+            let n0 = self.particles.len();
+            let pos = self.particles.pos.clone();
+            self.particles.retain(|i| dom.contains(pos[i]));
+            self.st.removed += (n0 - self.particles.len()) as u64;
+        }
+
+        // 3. Sort by cell.
+        let r_max = self.particles.radius.iter().copied().fold(0.0, f64::max);
+        self.st.r_max = r_max;
+        let (range_pp, range_pw) = self.range_max(r_max);
+        let skin = self.skin();
+        let n = self.particles.len();
+        let cell = (2.0 * r_max + range_pp + skin).max(1e-300);
+        if n > 0 {
+            self.scratch.grid.rebuild(&self.particles.pos, cell);
+            self.scratch.perm.clear();
+            self.scratch.perm.extend_from_slice(self.scratch.grid.entries());
+            self.particles.permute(&self.scratch.perm, &mut self.scratch.permute);
+        }
+
+        // 4. Half list. After the permutation, new index k is entries()[k], so the grid's cell ranges are
+        //    ranges of new indices.
+        let p = &self.particles;
+        let grid = &self.scratch.grid;
+        let extra = range_pp + skin;
+        let both_frozen = |i: usize, j: usize| p.inv_mass[i] == 0.0 && p.inv_mass[j] == 0.0;
+        let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let (i0, i1) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+                let mut counts = Vec::with_capacity(i1 - i0);
+                let mut nb = Vec::with_capacity((i1 - i0) * 8);
+                for i in i0..i1 {
+                    let xi = p.pos[i];
+                    let ri = p.radius[i];
+                    let before = nb.len();
+                    grid.for_each_candidate_run(xi, |run| {
+                        for j in run.start.max(i + 1)..run.end {
+                            let c = ri + p.radius[j] + extra;
+                            if (p.pos[j] - xi).length_squared() < c * c && !both_frozen(i, j) {
+                                nb.push(j as u32);
+                            }
+                        }
+                    });
+                    counts.push((nb.len() - before) as u32);
+                }
+                (counts, nb)
+            })
+            .collect();
+        let list = &mut self.st.list;
+        list.start.clear();
+        list.start.push(0);
+        list.nbr.clear();
+        let mut span = 1usize;
+        for (counts, nb) in &parts {
+            let mut k = 0usize;
+            for &c in counts {
+                let i = list.start.len() - 1;
+                let s = &nb[k..k + c as usize];
+                if let Some(&last) = s.last() {
+                    span = span.max(last as usize - i + 1);
+                }
+                list.nbr.extend_from_slice(s);
+                k += c as usize;
+                list.start.push(list.nbr.len() as u32);
+            }
+        }
+        drop(parts);
+        colour_phases(n, span, &mut list.phases);
+
+        // 5. Restore pair states.
+        list.state.clear();
+        list.state.resize(list.nbr.len(), default);
+        if !carry.is_empty() {
+            let reach = range_pp;
+            for i in 0..n {
+                for k in list.start[i] as usize..list.start[i + 1] as usize {
+                    let j = list.nbr[k] as usize;
+                    let c = p.radius[i] + p.radius[j] + reach;
+                    if (p.pos[j] - p.pos[i]).length_squared() >= c * c * (1.0 + 1e-9) + 1e-300 {
+                        continue;
+                    }
+                    let key = pair_key(p.id[i], p.id[j]);
+                    if let Ok(m) = carry.binary_search_by_key(&key, |c| c.0) {
+                        list.state[k] = carry[m].1;
+                    }
+                }
+            }
+        }
+
+        // 6. Wall candidates.
+        let t = self.st.time;
+        let kin: Vec<WallKinematics> = self.walls.iter().map(|w| WallKinematics::of(&w.motion, t)).collect();
+        let walls = &self.walls;
+        type Part = (Vec<u32>, Vec<(u16, u32)>);
+        let wparts: Vec<Part> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let (i0, i1) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+                let mut counts = Vec::with_capacity(i1 - i0);
+                let mut slots = Vec::new();
+                let mut tris = Vec::new();
+                for i in i0..i1 {
+                    let before = slots.len();
+                    if p.inv_mass[i] != 0.0 {
+                        let reach = p.radius[i] + range_pw + skin;
+                        for (w, wall) in walls.iter().enumerate() {
+                            let x = kin[w].to_reference(p.pos[i]);
+                            match &wall.shape {
+                                WallShape::Mesh(m) => {
+                                    tris.clear();
+                                    m.for_each_near(x, reach, |tri| tris.push(tri));
+                                    tris.sort_unstable();
+                                    slots.extend(tris.iter().map(|&tri| (w as u16, tri)));
+                                }
+                                _ => {
+                                    if wall.analytic_hit(x, reach).is_some() {
+                                        slots.push((w as u16, 0));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    counts.push((slots.len() - before) as u32);
+                }
+                (counts, slots)
+            })
+            .collect();
+        let wl = &mut self.st.wall_list;
+        wl.start.clear();
+        wl.start.push(0);
+        wl.wall.clear();
+        wl.tri.clear();
+        for (counts, slots) in &wparts {
+            let mut k = 0;
+            for &c in counts {
+                for &(w, tri) in &slots[k..k + c as usize] {
+                    wl.wall.push(w);
+                    wl.tri.push(tri);
+                }
+                k += c as usize;
+                wl.start.push(wl.wall.len() as u32);
+            }
+        }
+        wl.state.clear();
+        wl.state.resize(wl.wall.len(), default);
+        wl.out.clear();
+        wl.out.resize(wl.wall.len(), SlotOut::default());
+        if !wall_carry.is_empty() {
+            for i in 0..n {
+                for k in wl.start[i] as usize..wl.start[i + 1] as usize {
+                    let key = (p.id[i], wl.wall[k], wl.tri[k]);
+                    if let Ok(m) = wall_carry.binary_search_by_key(&key, |c| c.0) {
+                        wl.state[k] = wall_carry[m].1;
+                    }
+                }
+            }
+        }
+        blocks(n, BLOCK, &mut wl.blocks);
+
+        self.st.disp_particles = 0.0;
+        self.st.disp_walls = 0.0;
+        self.st.needs_rebuild = false;
+        self.st.rebuilds += 1;
+    }
+}
+
+/// Order-independent key of a particle pair.
+#[inline]
+fn pair_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}

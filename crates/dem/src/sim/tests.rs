@@ -1,0 +1,184 @@
+//! Engine tests: thread-count independence, energy conservation and dissipation, a settled pile.
+
+use super::*;
+use crate::contact::{
+    Composed, Frictionless, Hertz, HertzMindlin, HertzMindlinRolling, NoDamping, NoRolling,
+};
+use crate::insertion::{random_fill, FillTarget, Region};
+use crate::walls::{MeshWall, Plane, Wall, WallShape};
+use spatter_core::distribution::SizeDistribution;
+use spatter_core::mesh::TriMesh;
+use spatter_core::motion::Motion;
+use spatter_core::rng::seeded;
+
+/// Six planes around the box [0, l]³ (material `mat`), optionally with the floor as a mesh.
+fn box_walls<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, mat: u16, floor_mat: u16, mesh_floor: bool) {
+    let planes = [
+        (Vec3::ZERO, Vec3::X),
+        (Vec3::splat(l), -Vec3::X),
+        (Vec3::ZERO, Vec3::Y),
+        (Vec3::splat(l), -Vec3::Y),
+        (Vec3::splat(l), -Vec3::Z),
+    ];
+    for (k, (p, n)) in planes.iter().enumerate() {
+        sim.add_wall(Wall {
+            name: format!("side{k}"),
+            shape: WallShape::Plane(Plane::new(*p, *n)),
+            material: mat,
+            motion: Motion::Fixed,
+        });
+    }
+    let floor = if mesh_floor {
+        // A 3 × 3 patch of triangles covering the floor, extended beyond the box.
+        let mut m = TriMesh::rectangle(l + 0.2 * l, l + 0.2 * l, 0.0, 3, 3);
+        m.map_vertices(|v| v - Vec3::new(0.1 * l, 0.1 * l, 0.0));
+        WallShape::Mesh(Box::new(MeshWall::new(m)))
+    } else {
+        WallShape::Plane(Plane::new(Vec3::ZERO, Vec3::Z))
+    };
+    sim.add_wall(Wall { name: "floor".into(), shape: floor, material: floor_mat, motion: Motion::Fixed });
+}
+
+fn soft() -> Material {
+    Material::new(5e7, 0.3, 2500.0).unwrap()
+}
+
+fn fill<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, n: u64, d: (f64, f64), speed: f64, seed: u64) {
+    let region = Region::Box(Aabb::new(Vec3::ZERO, Vec3::splat(l)));
+    let mut rng = seeded(seed, 0);
+    let dist = SizeDistribution::Uniform { min: d.0, max: d.1 };
+    let got = random_fill(&region, &dist, FillTarget::Count(n), &[], 100_000, &mut rng);
+    assert_eq!(got.len() as u64, n);
+    use spatter_core::rng::RngExt;
+    for (x, r) in got {
+        let mut p = crate::NewParticle::at(x, r, 0);
+        let u = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5);
+        p.vel = u * (2.0 * speed);
+        p.omega = Vec3::new(rng.random::<f64>() - 0.5, 0.0, rng.random::<f64>() - 0.5) * (speed / r);
+        sim.add_particle(p);
+    }
+}
+
+#[test]
+fn results_are_bit_identical_for_one_and_two_threads() {
+    // A dense little pile with friction, damping, rolling-free Hertz–Mindlin, planes and a mesh floor;
+    // the colouring groups depend on the data only, so 1 and 2 threads must agree to the bit.
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mats = vec![soft(), Material::new(1e8, 0.3, 2500.0).unwrap()];
+            let pairs = uniform_pairs(&mats, 0.5, 0.5);
+            let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, 2e-5, Settings::default());
+            sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+            box_walls(&mut sim, 0.1, 1, 1, true);
+            fill(&mut sim, 0.1, 700, (0.006, 0.009), 0.5, 11);
+            sim.run_steps(400).unwrap();
+            assert!(sim.rebuild_count() > 2, "lists were rebuilt during the run");
+            assert!(sim.last_evaluation().pair_contacts > 20, "{}", sim.last_evaluation().pair_contacts);
+            (sim.particles.clone(), sim.energy())
+        })
+    };
+    let (a, ea) = run(1);
+    let (b, eb) = run(2);
+    assert_eq!(a, b, "particle state differs between 1 and 2 threads");
+    assert_eq!(ea.total().to_bits(), eb.total().to_bits());
+}
+
+#[test]
+fn elastic_box_conserves_energy_and_the_budget_closes_with_friction() {
+    // 300 elastic frictionless spheres in a box of planes, no gravity: KE + rotational + elastic must stay
+    // constant. Tolerance 2e-3 relative over ~40 collision times per particle with 60 steps per Hertz
+    // contact time (velocity Verlet energy error is O(dt²) per contact and does not accumulate).
+    let mats = vec![soft()];
+    let pairs = uniform_pairs(&mats, 0.0, 1.0);
+    let law: Composed<Hertz, NoDamping, Frictionless, NoRolling> = Composed::default();
+    let r_min: f64 = 0.004;
+    let m_min = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r_min.powi(3);
+    let tc = spatter_core::timestep::hertz_time(0.5 * m_min, 0.5 * r_min, pairs.get(0, 0).e_star, 4.0);
+    let mut sim = Simulation::new(law, mats.clone(), pairs.clone(), tc / 60.0, Settings::default());
+    box_walls(&mut sim, 0.1, 0, 0, false);
+    fill(&mut sim, 0.1, 300, (0.008, 0.012), 1.0, 5);
+    let e0 = sim.energy().total();
+    let mut max_dev: f64 = 0.0;
+    for _ in 0..40 {
+        sim.run_steps(100).unwrap();
+        max_dev = max_dev.max((sim.energy().total() / e0 - 1.0).abs());
+    }
+    assert!(sim.energy().dissipated == 0.0);
+    assert!(max_dev < 2e-3, "elastic energy drift {max_dev}");
+
+    // With Coulomb friction and damping the mechanical energy falls, and mechanical + dissipated stays at
+    // its initial value. Tolerance 2.5 %: dissipation is booked with the velocities the forces were
+    // evaluated with (half-step velocities under Verlet), an O(Δt) error; at t_c/60 this frictional gas
+    // (each particle ~40 collisions) ends 1.0 % off, at t_c/240 0.24 % (measured, first order).
+    let mut sim = Simulation::new(
+        HertzMindlin::default(),
+        mats,
+        uniform_pairs(&[soft()], 0.4, 0.7),
+        tc / 60.0,
+        Settings::default(),
+    );
+    box_walls(&mut sim, 0.1, 0, 0, false);
+    fill(&mut sim, 0.1, 300, (0.008, 0.012), 1.0, 5);
+    let e0 = sim.energy();
+    sim.run_steps(4000).unwrap();
+    let e1 = sim.energy();
+    assert!(e1.mechanical() < 0.8 * e0.mechanical(), "damping works");
+    assert!((e1.total() / e0.total() - 1.0).abs() < 0.025, "budget: {} vs {}", e1.total(), e0.total());
+}
+
+#[test]
+fn damped_contacts_never_gain_energy() {
+    // Damped, frictional, with gravity: the mechanical energy (kinetic + rotational + elastic + potential)
+    // must never exceed its initial value (tolerance 1e-9 relative for round-off), and must fall.
+    let mats = vec![soft()];
+    let pairs = uniform_pairs(&mats, 0.5, 0.5);
+    let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, 2e-5, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    box_walls(&mut sim, 0.1, 0, 0, true);
+    fill(&mut sim, 0.1, 300, (0.008, 0.012), 0.5, 9);
+    let e0 = sim.energy().mechanical();
+    for _ in 0..300 {
+        sim.run_steps(10).unwrap();
+        let e = sim.energy().mechanical();
+        assert!(e <= e0 + 1e-9 * e0.abs(), "energy grew: {e} > {e0}");
+    }
+    assert!(sim.energy().mechanical() < e0);
+}
+
+#[test]
+fn settled_pile_rests_and_the_floor_carries_its_weight() {
+    // Spheres (with rolling resistance μ_r = 0.05, else free spheres keep rolling for a long time) poured
+    // into a box with frictionless side walls settle; then the kinetic energy is below 1e-6 of the
+    // potential energy released, and the floor force equals the total weight within 1 % (side walls
+    // without friction carry no vertical load, so statics demands exactly the weight).
+    let mats = vec![soft(), soft()];
+    let mut pairs = uniform_pairs(&mats, 0.5, 0.3);
+    pairs = pairs.map(|k, p| {
+        let mut p = p.clone();
+        if k != 0 {
+            p.friction = 0.0;
+        }
+        p
+    });
+    let pairs = pairs.map(|_, p| {
+        let mut p = p.clone();
+        p.rolling_friction = 0.05;
+        p
+    });
+    let mut sim = Simulation::new(HertzMindlinRolling::default(), mats, pairs, 4e-5, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    box_walls(&mut sim, 0.1, 1, 0, false);
+    fill(&mut sim, 0.1, 250, (0.008, 0.012), 0.2, 21);
+    let pe0 = sim.energy().potential;
+    let weight: f64 = sim.particles.mass.iter().sum::<f64>() * 9.81;
+    sim.run_steps(15_000).unwrap();
+    let e = sim.energy();
+    let floor = sim.walls.len() - 1;
+    let f = sim.wall_force(floor);
+    assert!(e.kinetic < 1e-6 * (pe0 - e.potential), "still moving: {e:?}");
+    // Spin about a single contact normal (a sphere twisting on the floor) meets no resistance without a
+    // torsion model, so the rotational energy decays more slowly; it must still be tiny.
+    assert!(e.rotational < 1e-5 * (pe0 - e.potential), "still spinning: {e:?}");
+    assert!((-f.z / weight - 1.0).abs() < 0.01, "floor force {} N vs weight {weight} N", -f.z);
+}
