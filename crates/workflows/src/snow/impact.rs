@@ -1,0 +1,526 @@
+//! The single-impact driver: one sphere hits a flat wall, a single sphere (frozen or free) or a bed of
+//! frozen spheres, and the run reports stick or bounce.
+//!
+//! The contact forces come from the DEM engine's contact laws ([`ContactLaw::compute`]), the same code a
+//! full DEM run uses; only the integration loop is lean (one particle, one or a few contacts, no
+//! neighbour search). Time integration is velocity Verlet (as LIGGGHTS): half kick, drift, forces at the
+//! new positions with the half-step velocities, half kick.
+//!
+//! # Set-up
+//!
+//! The particle starts exactly at first touch with its impact velocity (the thesis placed it so that the
+//! contact began at one fixed time step whatever the speed, digest §5.1): contact forms at step 0. The
+//! wall normal is +z; the tangential velocity is along +x. For a sphere or a bed the start point is found
+//! by sweeping the particle along its straight approach path to the first touching partner.
+//!
+//! # Outcome
+//!
+//! The run ends as soon as the outcome is certain:
+//!
+//! * **bounce** — no contact is left and the particle moves away on a path that meets no partner;
+//! * **stick** — the mechanical energy left (kinetic + energy stored in the contacts, minus the motion of
+//!   the centre of mass of a free pair) is below the work needed to break every active contact
+//!   (Σ U_break; JKR W_neck = 0.935503 F_cδ_c, zero for laws without a neck), with a safety margin. Damping,
+//!   friction and breaking only remove energy, so such a particle can never leave;
+//! * otherwise at the **check time**, where the particle sticks if a contact is still active (thesis
+//!   criterion: the normal overlap persists) and, under [`StickCriterion::StaticTangential`], the contact
+//!   point also does not slide.
+
+use serde::{Deserialize, Serialize};
+use spatter_core::Vec3;
+use spatter_dem::contact::{ContactInput, ContactLaw};
+
+/// How a run decides that a particle stuck.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StickCriterion {
+    /// A contact is still active at the check time (snow thesis, L483). Default.
+    #[default]
+    NormalOverlap,
+    /// As [`StickCriterion::NormalOverlap`], and the contact point does not slide at the check time
+    /// (the particle centre moves tangentially slower than `static_slip_ratio` × the impact speed, so
+    /// neither sliding nor rolling): the thesis's originally intended criterion (position unchanged).
+    StaticTangential,
+}
+
+/// Stick or bounce.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Outcome {
+    Stick,
+    Bounce,
+}
+
+/// Why a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Decision {
+    /// All contacts broke and the particle flies away.
+    Separated,
+    /// The remaining energy cannot break the active contacts.
+    Bound,
+    /// The check time was reached.
+    CheckTime,
+}
+
+impl Decision {
+    /// Short code for CSV files: 0 separated, 1 bound, 2 check time.
+    pub fn code(self) -> f64 {
+        match self {
+            Decision::Separated => 0.0,
+            Decision::Bound => 1.0,
+            Decision::CheckTime => 2.0,
+        }
+    }
+}
+
+/// A rigid sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Radius \[m\].
+    pub radius: f64,
+    /// Mass \[kg\].
+    pub mass: f64,
+}
+
+impl Sphere {
+    /// A sphere of diameter `d` \[m\] and density `rho` \[kg/m³\].
+    pub fn of_diameter(d: f64, rho: f64) -> Self {
+        Sphere { radius: 0.5 * d, mass: rho * std::f64::consts::PI / 6.0 * d * d * d }
+    }
+
+    /// Moment of inertia (2/5) m R² \[kg m²\].
+    pub fn inertia(&self) -> f64 {
+        0.4 * self.mass * self.radius * self.radius
+    }
+}
+
+/// A frozen sphere of a rough wall.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BedSphere {
+    /// Centre \[m\].
+    pub centre: [f64; 3],
+    /// Radius \[m\].
+    pub radius: f64,
+}
+
+/// What the particle hits.
+#[derive(Clone, Copy, Debug)]
+pub enum Target<'a> {
+    /// The flat wall z = 0 (particle–wall).
+    Plane,
+    /// One sphere centred at the origin: frozen (infinite mass, a wall sphere) or free (particle–particle,
+    /// initially at rest).
+    Sphere { radius: f64, free_mass: Option<f64> },
+    /// A bed of frozen spheres below z = `top` (rough wall); the particle comes from above.
+    Bed { spheres: &'a [BedSphere], top: f64 },
+}
+
+/// One impact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Impact {
+    /// The moving particle.
+    pub particle: Sphere,
+    /// Normal approach speed v_n > 0 \[m/s\] (towards the wall, along −z).
+    pub normal_speed: f64,
+    /// Tangential speed v_t ≥ 0 \[m/s\] along +x.
+    pub tangential_speed: f64,
+    /// Lateral aim point (x, y) \[m\] of the approach path (bed and sphere targets).
+    pub aim: [f64; 2],
+}
+
+/// Integration and classification settings of one run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriverSettings {
+    /// Time step \[s\].
+    pub dt: f64,
+    /// Time after first touch at which the outcome is read \[s\].
+    pub check_time: f64,
+    /// Stick criterion.
+    pub criterion: StickCriterion,
+    /// Slip speed below which a contact counts as static, as a fraction of the impact speed.
+    pub static_slip_ratio: f64,
+    /// Relative safety margin of the energy test for an early stick decision (e.g. 0.01).
+    pub bound_margin: f64,
+    /// Evaluate velocity-dependent forces with velocities predicted to the end of the step (second-order
+    /// accurate dashpots) instead of the half-step velocities of plain velocity Verlet (LIGGGHTS).
+    pub predict_velocity: bool,
+}
+
+/// The result of one impact.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImpactResult {
+    pub outcome: Outcome,
+    pub decision: Decision,
+    /// Particle velocity at the end (relative to a free partner) \[m/s\].
+    pub rebound_velocity: [f64; 3],
+    /// Realised normal restitution: rebound normal speed / impact normal speed (0 when stuck).
+    pub restitution: f64,
+    /// Largest overlap over all contacts \[m\].
+    pub max_overlap: f64,
+    /// Time from first touch to the last contact break \[s\]; for a stuck particle the time simulated.
+    pub contact_duration: f64,
+    /// Slip speed of the contact point at the end \[m/s\].
+    pub slip_speed: f64,
+    /// Tangential speed of the particle centre (relative to the partner) at the end \[m/s\].
+    pub tangential_speed: f64,
+    /// Time steps integrated.
+    pub steps: u64,
+}
+
+/// Geometry of a contact seen from the particle.
+#[derive(Clone, Copy)]
+struct Geom {
+    n: Vec3,
+    overlap: f64,
+    r_partner: f64,
+}
+
+/// One active contact: partner index, law state, energy needed to break it.
+struct Slot<S> {
+    id: usize,
+    state: S,
+    u_break: f64,
+}
+
+/// The state of the moving bodies.
+#[derive(Clone, Copy)]
+struct Bodies {
+    x: Vec3,
+    v: Vec3,
+    w: Vec3,
+    /// Free partner (sphere target only).
+    xp: Vec3,
+    vp: Vec3,
+    wp: Vec3,
+}
+
+/// Forces and torques on particle (f, t) and partner (fp, tp).
+#[derive(Clone, Copy, Default)]
+struct Loads {
+    f: Vec3,
+    t: Vec3,
+    fp: Vec3,
+    tp: Vec3,
+    energy: f64,
+    u_break: f64,
+    max_overlap: f64,
+    slip: f64,
+}
+
+/// Runs one impact with contact law `law` and its pair parameters `params`.
+///
+/// `break_energy(r_eff)` is the energy \[J\] needed to break a freshly formed contact of effective radius
+/// `r_eff` (JKR neck work; 0 for laws without a neck).
+pub fn run_impact<L: ContactLaw>(
+    law: &L,
+    params: &L::Params,
+    break_energy: &dyn Fn(f64) -> f64,
+    target: Target<'_>,
+    imp: &Impact,
+    s: &DriverSettings,
+) -> ImpactResult {
+    let p = imp.particle;
+    let r = p.radius;
+    let m = p.mass;
+    let inertia = p.inertia();
+    let v0 = Vec3::new(imp.tangential_speed, 0.0, -imp.normal_speed);
+    let speed0 = v0.length();
+    let (free_mass, partner_radius) = match target {
+        Target::Sphere { radius, free_mass } => (free_mass, radius),
+        _ => (None, 0.0),
+    };
+    let partner_inertia = free_mass.map(|mp| 0.4 * mp * partner_radius * partner_radius);
+
+    // Start at first touch.
+    let x0 = start_position(target, r, imp.aim, v0);
+    let mut b = Bodies { x: x0, v: v0, w: Vec3::ZERO, xp: Vec3::ZERO, vp: Vec3::ZERO, wp: Vec3::ZERO };
+
+    let mut slots: Vec<Slot<L::State>> = Vec::with_capacity(4);
+    let range_of = |rp: f64| law.range(params, if rp.is_infinite() { r } else { r * rp / (r + rp) });
+    let max_bed_radius = match target {
+        Target::Bed { spheres, .. } => spheres.iter().map(|q| q.radius).fold(0.0, f64::max),
+        _ => 0.0,
+    };
+    let bed_range = range_of(max_bed_radius.max(1e-300));
+    let bed_reach = r + max_bed_radius + bed_range;
+
+    // Candidate bed spheres near the particle (a Verlet list with a skin of one bed-sphere diameter),
+    // rebuilt when the particle has moved by half the skin.
+    let mut candidates: Vec<usize> = Vec::new();
+    let mut list_centre = Vec3::splat(f64::INFINITY);
+    let list_skin = (2.0 * max_bed_radius).max(1e-3 * r);
+
+    let dt = s.dt;
+    let compute = |b: &Bodies,
+                   slots: &mut Vec<Slot<L::State>>,
+                   candidates: &mut Vec<usize>,
+                   lc: &mut Vec3| {
+        let mut l = Loads::default();
+        let mut visit = |id: usize, g: Geom, slots: &mut Vec<Slot<L::State>>| {
+            let pos = slots.iter().position(|sl| sl.id == id);
+            let r_eff = if g.r_partner.is_infinite() { r } else { r * g.r_partner / (r + g.r_partner) };
+            if pos.is_none() && g.overlap < -law.range(params, r_eff) {
+                return;
+            }
+            let (partner_v, partner_w, i_eff) = match (free_mass, partner_inertia) {
+                (Some(_), Some(ip)) => (b.vp, b.wp, 1.0 / (1.0 / inertia + 1.0 / ip)),
+                _ => (Vec3::ZERO, Vec3::ZERO, inertia),
+            };
+            let m_eff = match free_mass {
+                Some(mp) => m * mp / (m + mp),
+                None => m,
+            };
+            let v_rel = b.v + b.w.cross(-r * g.n)
+                - (partner_v
+                    + partner_w.cross(if g.r_partner.is_finite() { g.r_partner * g.n } else { Vec3::ZERO }));
+            let input = ContactInput {
+                normal: g.n,
+                overlap: g.overlap,
+                r_eff,
+                m_eff,
+                i_eff,
+                v_rel,
+                w_rel: b.w - partner_w,
+                dt,
+            };
+            let idx = match pos {
+                Some(i) => i,
+                None => {
+                    slots.push(Slot { id, state: L::State::default(), u_break: break_energy(r_eff) });
+                    slots.len() - 1
+                }
+            };
+            match law.compute(params, &input, &mut slots[idx].state) {
+                Some(out) => {
+                    let ft = out.tangential_force(g.n);
+                    l.f += out.force;
+                    l.t += (-r * g.n).cross(ft) + out.rolling_torque;
+                    if g.r_partner.is_finite() {
+                        l.fp -= out.force;
+                        l.tp += -(g.r_partner * g.n).cross(ft) - out.rolling_torque;
+                    }
+                    l.energy += out.energy;
+                    l.u_break += slots[idx].u_break;
+                    l.max_overlap = l.max_overlap.max(g.overlap);
+                    let vt = v_rel - v_rel.dot(g.n) * g.n;
+                    l.slip = l.slip.max(vt.length());
+                }
+                None => {
+                    slots.swap_remove(idx);
+                }
+            }
+        };
+        match target {
+            Target::Plane => {
+                visit(0, Geom { n: Vec3::Z, overlap: r - b.x.z, r_partner: f64::INFINITY }, slots);
+            }
+            Target::Sphere { radius, .. } => {
+                let d = b.x - b.xp;
+                let dist = d.length();
+                visit(0, Geom { n: d / dist, overlap: r + radius - dist, r_partner: radius }, slots);
+            }
+            Target::Bed { spheres, .. } => {
+                if (b.x - *lc).length() > 0.5 * list_skin {
+                    *lc = b.x;
+                    candidates.clear();
+                    let reach = bed_reach + list_skin;
+                    for (i, q) in spheres.iter().enumerate() {
+                        let c = Vec3::from(q.centre);
+                        if (b.x - c).length_squared() < reach * reach {
+                            candidates.push(i);
+                        }
+                    }
+                }
+                for &i in candidates.iter() {
+                    let q = spheres[i];
+                    let d = b.x - Vec3::from(q.centre);
+                    let dist = d.length();
+                    if dist < r + q.radius + bed_reach && dist > 0.0 {
+                        visit(
+                            i,
+                            Geom { n: d / dist, overlap: r + q.radius - dist, r_partner: q.radius },
+                            slots,
+                        );
+                    }
+                }
+            }
+        }
+        l
+    };
+
+    let mut loads = compute(&b, &mut slots, &mut candidates, &mut list_centre);
+    let mut max_overlap = loads.max_overlap;
+    let mut last_contact_time = 0.0;
+    let mut t = 0.0;
+    let max_steps = (s.check_time / dt).ceil().max(1.0) as u64;
+    let total_mass = m + free_mass.unwrap_or(0.0);
+    let mut decision = Decision::CheckTime;
+    let mut steps = 0u64;
+    let needs_static = s.criterion == StickCriterion::StaticTangential
+        && !(imp.tangential_speed == 0.0 && matches!(target, Target::Plane));
+
+    while steps < max_steps {
+        // Velocity Verlet.
+        b.v += 0.5 * dt / m * loads.f;
+        b.w += 0.5 * dt / inertia * loads.t;
+        if let (Some(mp), Some(ip)) = (free_mass, partner_inertia) {
+            b.vp += 0.5 * dt / mp * loads.fp;
+            b.wp += 0.5 * dt / ip * loads.tp;
+            b.xp += dt * b.vp;
+        }
+        b.x += dt * b.v;
+        loads = if s.predict_velocity {
+            // Forces at t + Δt with velocities predicted to t + Δt (second order for the dashpots).
+            let mut bp = b;
+            bp.v += 0.5 * dt / m * loads.f;
+            bp.w += 0.5 * dt / inertia * loads.t;
+            if let (Some(mp), Some(ip)) = (free_mass, partner_inertia) {
+                bp.vp += 0.5 * dt / mp * loads.fp;
+                bp.wp += 0.5 * dt / ip * loads.tp;
+            }
+            compute(&bp, &mut slots, &mut candidates, &mut list_centre)
+        } else {
+            compute(&b, &mut slots, &mut candidates, &mut list_centre)
+        };
+        b.v += 0.5 * dt / m * loads.f;
+        b.w += 0.5 * dt / inertia * loads.t;
+        if let (Some(mp), Some(ip)) = (free_mass, partner_inertia) {
+            b.vp += 0.5 * dt / mp * loads.fp;
+            b.wp += 0.5 * dt / ip * loads.tp;
+        }
+        steps += 1;
+        t += dt;
+        max_overlap = max_overlap.max(loads.max_overlap);
+        if !slots.is_empty() {
+            last_contact_time = t;
+            // Energy of the relative motion (the centre of mass of a free pair keeps its energy).
+            let mut e = 0.5 * m * b.v.length_squared() + 0.5 * inertia * b.w.length_squared() + loads.energy;
+            if let (Some(mp), Some(ip)) = (free_mass, partner_inertia) {
+                let vcm = (m * b.v + mp * b.vp) / total_mass;
+                e += 0.5 * mp * b.vp.length_squared() + 0.5 * ip * b.wp.length_squared()
+                    - 0.5 * total_mass * vcm.length_squared();
+            }
+            if !needs_static
+                && e < loads.u_break - s.bound_margin * loads.u_break.abs().max(f64::MIN_POSITIVE)
+            {
+                decision = Decision::Bound;
+                break;
+            }
+        } else if receding(target, &b, r, bed_range) {
+            decision = Decision::Separated;
+            break;
+        }
+    }
+
+    let rel_v = b.v - b.vp;
+    let wall_normal = match target {
+        Target::Sphere { .. } => (b.x - b.xp).normalize(),
+        _ => Vec3::Z,
+    };
+    let tangential_speed = (rel_v - rel_v.dot(wall_normal) * wall_normal).length();
+    let stuck = match decision {
+        Decision::Separated => false,
+        Decision::Bound => true,
+        Decision::CheckTime => {
+            !slots.is_empty()
+                && (s.criterion == StickCriterion::NormalOverlap
+                    || tangential_speed <= s.static_slip_ratio * speed0.max(f64::MIN_POSITIVE))
+        }
+    };
+    let normal_out = rel_v.dot(wall_normal);
+    ImpactResult {
+        outcome: if stuck { Outcome::Stick } else { Outcome::Bounce },
+        decision,
+        rebound_velocity: rel_v.to_array(),
+        restitution: if stuck { 0.0 } else { normal_out.max(0.0) / imp.normal_speed },
+        max_overlap,
+        contact_duration: if stuck { t } else { last_contact_time },
+        slip_speed: loads.slip,
+        tangential_speed,
+        steps,
+    }
+}
+
+/// Whether a particle without contacts is moving away for good; `range` is the largest gap at which a
+/// bed contact can act.
+fn receding(target: Target<'_>, b: &Bodies, r: f64, range: f64) -> bool {
+    match target {
+        Target::Plane => b.v.z > 0.0,
+        Target::Sphere { .. } => (b.v - b.vp).dot(b.x - b.xp) > 0.0,
+        Target::Bed { spheres, top } => {
+            if b.v.z <= 0.0 {
+                return false;
+            }
+            if b.x.z - r > top + range {
+                return true;
+            }
+            // The straight path ahead must not come within range of any bed sphere.
+            let u = b.v.normalize();
+            spheres.iter().all(|q| {
+                let c = Vec3::from(q.centre);
+                sweep_hit(b.x, u, c, r + q.radius + range).is_none()
+            })
+        }
+    }
+}
+
+/// Distance s ≥ 0 along unit direction `u` from `o` at which a point comes within `rr` of `c`.
+fn sweep_hit(o: Vec3, u: Vec3, c: Vec3, rr: f64) -> Option<f64> {
+    let oc = o - c;
+    let bq = u.dot(oc);
+    let cq = oc.length_squared() - rr * rr;
+    if cq <= 0.0 {
+        return Some(0.0);
+    }
+    if bq >= 0.0 {
+        return None;
+    }
+    let disc = bq * bq - cq;
+    (disc >= 0.0).then(|| -bq - disc.sqrt())
+}
+
+/// Position of first touch along the approach path through the aim point.
+fn start_position(target: Target<'_>, r: f64, aim: [f64; 2], v0: Vec3) -> Vec3 {
+    match target {
+        Target::Plane => Vec3::new(aim[0], aim[1], r),
+        Target::Sphere { radius, .. } => {
+            let u = v0.normalize();
+            let far = Vec3::new(aim[0], aim[1], 0.0) - u * (10.0 * (r + radius));
+            match sweep_hit(far, u, Vec3::ZERO, r + radius) {
+                Some(s) => touch(far + u * s, Vec3::ZERO, r + radius),
+                // A miss: start level with the sphere's top, the particle passes by.
+                None => far,
+            }
+        }
+        Target::Bed { spheres, top } => {
+            let u = v0.normalize();
+            let lift = (top + 2.0 * r) / (-u.z).max(1e-3);
+            let far = Vec3::new(aim[0], aim[1], 0.0) - u * lift;
+            let mut best: Option<(f64, Vec3, f64)> = None;
+            for q in spheres {
+                let c = Vec3::from(q.centre);
+                if let Some(s) = sweep_hit(far, u, c, r + q.radius) {
+                    if best.is_none_or(|(bs, _, _)| s < bs) {
+                        best = Some((s, c, r + q.radius));
+                    }
+                }
+            }
+            match best {
+                Some((s, c, rr)) => touch(far + u * s, c, rr),
+                None => Vec3::new(aim[0], aim[1], r),
+            }
+        }
+    }
+}
+
+/// Nudges `x` towards `c` until the overlap rr − |x − c| is not negative (rounding of the sweep).
+fn touch(mut x: Vec3, c: Vec3, rr: f64) -> Vec3 {
+    for _ in 0..8 {
+        let d = x - c;
+        let gap = d.length() - rr;
+        if gap <= 0.0 {
+            break;
+        }
+        x -= d.normalize() * (gap + rr * f64::EPSILON);
+    }
+    x
+}

@@ -1,0 +1,23 @@
+//! Snow adhesion: stick/bounce regime maps of dry snow grains hitting car plastics.
+
+pub mod bed;
+pub mod bisection;
+pub mod config;
+pub mod fit;
+pub mod impact;
+pub mod material;
+pub mod model;
+pub mod output;
+pub mod regime;
+pub mod runner;
+
+pub use config::SnowConfig;
+pub use runner::{run, SnowError};
+pub mod bench;
+pub mod validation;
+
+pub use bench::bench;
+pub use validation::validation_cases;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,630 @@
+//! `run(cfg, ctx)`: the four modes of the `snow_regime_map` scenario, parallel over impacts, stoppable
+//! and resumable.
+//!
+//! Work is a list of independent jobs (impacts, or one bisection per diameter) done in chunks with rayon.
+//! Between chunks the run polls [`RunControl::stop_requested`]; on a stop it saves the finished results in
+//! `checkpoint.bin` and returns [`Finished::Interrupted`]. On resume it reloads them and continues with
+//! the next job. Every job is deterministic and independent of the thread count, so a resumed run writes
+//! the same files as an uninterrupted one.
+
+use super::bed::{random_insertion, settled, wilson_interval, Bed};
+use super::bisection::{critical_speed, CriticalSpeed};
+use super::config::{Mode, Packing, SensitivityCase, SnowConfig};
+use super::material::TimeStepReport;
+use super::model::{ImpactModel, Surface};
+use super::output::{self, Axes, INTERFACE_RGB};
+use super::regime::{self, grid_jobs, run_job, ImpactRecord};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use spatter_core::check::{Checker, Invalid};
+use spatter_core::control::Finished;
+use spatter_core::material::effective_modulus;
+use spatter_core::rng::{seeded, RngExt};
+use spatter_core::Vec3;
+use spatter_dem::adhesion::tabor_parameter;
+use spatter_dem::restitution_models::RestitutionModel;
+use spatter_io::plot::Chart;
+use spatter_io::run::{RunContext, RunSummary};
+use std::io;
+use thiserror::Error;
+
+/// What can go wrong in a snow run.
+#[derive(Debug, Error)]
+pub enum SnowError {
+    #[error("invalid snow_regime_map configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
+    Invalid(Vec<Invalid>),
+    #[error("{0}")]
+    Io(#[from] io::Error),
+    #[error("checkpoint: {0}")]
+    Checkpoint(String),
+    #[error("cannot resume: {0}")]
+    Resume(String),
+}
+
+/// What `checkpoint.bin` holds.
+#[derive(Serialize, Deserialize)]
+struct Progress {
+    /// The configuration as JSON: a resume must use the same one.
+    config: String,
+    records: Vec<ImpactRecord>,
+    critical: Vec<CriticalSpeed>,
+}
+
+/// The impact model of `cfg` (baseline of the configuration).
+pub fn model_of(cfg: &SnowConfig) -> ImpactModel {
+    ImpactModel {
+        particle: cfg.particle.clone(),
+        wall: cfg.wall.clone(),
+        target: cfg.target,
+        partner_diameter: cfg.partner_diameter_m,
+        contact: cfg.contact.clone(),
+        integration: cfg.integration.clone(),
+    }
+}
+
+/// The configuration of sensitivity case `case`: the baseline with its values replaced.
+pub fn case_config(cfg: &SnowConfig, case: &SensitivityCase) -> SnowConfig {
+    let mut c = cfg.clone();
+    if let Some(e) = case.youngs_modulus_pa {
+        c.particle.youngs_modulus = e;
+    }
+    if let Some(nu) = case.poisson_ratio {
+        c.particle.poisson_ratio = nu;
+    }
+    if let Some(g) = case.work_of_adhesion_j_m2 {
+        c.contact.work_of_adhesion_j_m2 = g;
+    }
+    if let Some(sy) = case.yield_stress_pa {
+        c.contact.restitution = match c.contact.restitution {
+            RestitutionModel::Thornton { form, yield_geometry, .. } => {
+                RestitutionModel::Thornton { yield_stress_pa: sy, form, yield_geometry }
+            }
+            RestitutionModel::Constant { .. } => RestitutionModel::Thornton {
+                yield_stress_pa: sy,
+                form: Default::default(),
+                yield_geometry: Default::default(),
+            },
+        };
+    }
+    c
+}
+
+/// Does `jobs[done.len()..]` in chunks, polling for a stop between chunks.
+fn run_chunks<J: Sync, R: Send>(
+    jobs: &[J],
+    done: &mut Vec<R>,
+    chunk: usize,
+    ctx: &RunContext<'_>,
+    f: impl Fn(&J) -> R + Sync,
+) -> Finished {
+    while done.len() < jobs.len() {
+        if ctx.control.stop_requested() {
+            return Finished::Interrupted;
+        }
+        let end = (done.len() + chunk).min(jobs.len());
+        let new: Vec<R> = jobs[done.len()..end].par_iter().map(&f).collect();
+        done.extend(new);
+        ctx.control.progress(done.len() as u64, jobs.len() as u64);
+    }
+    Finished::Completed
+}
+
+fn config_json(cfg: &SnowConfig) -> String {
+    serde_json::to_string(cfg).unwrap_or_default()
+}
+
+fn load_progress(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<Progress, SnowError> {
+    let fresh = Progress { config: config_json(cfg), records: Vec::new(), critical: Vec::new() };
+    if !ctx.resume {
+        return Ok(fresh);
+    }
+    let path = ctx.dir.checkpoint_path();
+    if !path.exists() {
+        return Ok(fresh);
+    }
+    let p: Progress = spatter_io::checkpoint::load(&path)
+        .map_err(|e| SnowError::Checkpoint(format!("{}: {e}", path.display())))?;
+    if p.config != fresh.config {
+        return Err(SnowError::Resume(format!(
+            "{} was written by a different configuration; start afresh without --resume",
+            path.display()
+        )));
+    }
+    Ok(p)
+}
+
+fn interrupted(p: &Progress, ctx: &RunContext<'_>, total: usize) -> Result<RunSummary, SnowError> {
+    let path = ctx.dir.checkpoint_path();
+    spatter_io::checkpoint::save(&path, p)
+        .map_err(|e| SnowError::Checkpoint(format!("{}: {e}", path.display())))?;
+    let mut s = RunSummary::new(Finished::Interrupted);
+    s.headline.push(format!(
+        "stopped after {} of {total} jobs; checkpoint written to {}",
+        p.records.len().max(p.critical.len()),
+        path.display()
+    ));
+    Ok(s)
+}
+
+fn completed(ctx: &RunContext<'_>) {
+    let _ = std::fs::remove_file(ctx.dir.checkpoint_path());
+}
+
+/// Runs the `snow_regime_map` scenario `cfg` into `ctx.dir`.
+pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    Checker::run(cfg, None).map_err(SnowError::Invalid)?;
+    let mut summary = match cfg.mode {
+        Mode::Grid => run_grid(cfg, ctx)?,
+        Mode::Bisection => run_bisection(cfg, ctx)?,
+        Mode::Sensitivity => run_sensitivity(cfg, ctx)?,
+        Mode::RoughWall => run_rough_wall(cfg, ctx)?,
+    };
+    if summary.finished == Finished::Completed {
+        let mut lines = material_report(cfg);
+        lines.append(&mut summary.headline);
+        summary.headline = lines;
+        let log = summary.headline.join("\n") + "\n";
+        summary.artifacts.push(("summary".into(), ctx.dir.write_text("snow_summary.txt", &log)?));
+        completed(ctx);
+    }
+    Ok(summary)
+}
+
+/// Tabor parameter and time-step estimates at the smallest and largest diameter (printed for every run).
+pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
+    let (ds, v_max, partner_r) = match cfg.mode {
+        Mode::RoughWall => {
+            let v = cfg.rough_wall.speed_axis(cfg.grid.velocity_scale_m_s);
+            let d = cfg.rough_wall.particle_diameter_m;
+            (vec![d, d], v.last().copied().unwrap_or(1.0), Some(0.5 * cfg.rough_wall.bed_sphere_diameter_m))
+        }
+        _ => {
+            let d = cfg.grid.diameter_axis();
+            (vec![d[0], d[d.len() - 1]], cfg.grid.speed_range().1, None)
+        }
+    };
+    let e_star = effective_modulus(&cfg.particle, &cfg.wall);
+    let mut out = Vec::new();
+    let g = cfg.contact.work_of_adhesion_j_m2;
+    let mut tabor = Vec::new();
+    let mut steps = Vec::new();
+    for &d in &[ds[0], ds[1]] {
+        let r = 0.5 * d;
+        let r_star = partner_r.map_or(r, |rp| r * rp / (r + rp));
+        let m = cfg.particle.density * std::f64::consts::PI / 6.0 * d.powi(3);
+        tabor.push((tabor_parameter(r_star, g, e_star, 0.4e-9), tabor_parameter(r_star, g, e_star, 0.2e-9)));
+        let model = model_of(cfg);
+        let surface = match partner_r {
+            Some(rp) => Surface::Bed { spheres: &[], top: 0.0, sphere_radius: rp },
+            None => Surface::Configured,
+        };
+        let (_, setup) = model.setup(d, v_max, surface);
+        steps.push((TimeStepReport::new(d, &cfg.particle, e_star, r_star, m, v_max), setup.dt));
+    }
+    out.push(format!(
+        "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m, {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
+        tabor[0].0, tabor[0].1, ds[0], tabor[1].0, tabor[1].1, ds[1]
+    ));
+    for (i, (t, dt)) in steps.iter().enumerate() {
+        out.push(format!(
+            "time steps at d = {:.3e} m: thesis Eq. 24 {:.4e} s, Rayleigh {:.4e} s, Hertz time at {:.3} m/s {:.4e} s; used {:.4e} s",
+            ds[i], t.thesis_eq24, t.rayleigh, v_max, t.hertz, dt
+        ));
+    }
+    out
+}
+
+fn description(cfg: &SnowConfig, extra: &str) -> String {
+    format!(
+        "snow_regime_map {extra}: particle E = {} Pa, nu = {}, rho = {} kg/m3 on {:?} (wall E = {} Pa, nu = {}); \
+         {:?} normal law, work of adhesion {} J/m2, break {:?}, damping {:?}/{:?}, restitution {:?}",
+        cfg.particle.youngs_modulus,
+        cfg.particle.poisson_ratio,
+        cfg.particle.density,
+        cfg.target,
+        cfg.wall.youngs_modulus,
+        cfg.wall.poisson_ratio,
+        cfg.contact.normal_law,
+        cfg.contact.work_of_adhesion_j_m2,
+        cfg.contact.break_criterion,
+        cfg.contact.damping_stiffness,
+        cfg.contact.damping_calibration,
+        cfg.contact.restitution
+    )
+}
+
+/// Chunk size for `jobs` jobs: enough work per chunk for every thread, at least eight chunks per run so a
+/// stop request is answered promptly.
+fn chunk_size(jobs: usize) -> usize {
+    (jobs / 8).clamp(1, 64 * rayon::current_num_threads().max(1))
+}
+
+fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    let jobs = grid_jobs(&cfg.grid);
+    let model = model_of(cfg);
+    let mut p = load_progress(cfg, ctx)?;
+    ctx.control.status("snow regime map: grid");
+    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, |j| run_job(&model, j))
+        == Finished::Interrupted
+    {
+        return interrupted(&p, ctx, jobs.len());
+    }
+    let axes = Axes::of(&cfg.grid);
+    let mut s = RunSummary::new(Finished::Completed);
+    let impacts = ctx.dir.path("impacts.csv");
+    output::write_impacts(&impacts, &[(0, &p.records)])?;
+    s.artifacts.push(("every impact".into(), impacts));
+    let n_d = cfg.grid.diameters;
+    let n_v = cfg.grid.normal_speeds;
+    for (ai, angle) in cfg.grid.angles_deg.iter().enumerate() {
+        let recs = &p.records[ai * n_d * n_v..(ai + 1) * n_d * n_v];
+        let iface = regime::interface(&p.records, n_d, n_v, ai);
+        let suffix = if cfg.grid.angles_deg.len() > 1 { format!("_angle{ai}") } else { String::new() };
+        // Refinement bisects normal impacts, so it applies to the normal-impact angle only.
+        let points = if cfg.grid.refine_interface && *angle == 0.0 {
+            regime::refine(&model, &iface.brackets, cfg.bisection.relative_tolerance)
+        } else {
+            iface.points.clone()
+        };
+        let ipath = ctx.dir.path(&format!("interface{suffix}.csv"));
+        output::write_interface(&ipath, &iface.brackets, &points, &axes)?;
+        s.artifacts.push((format!("interface points at {angle} deg"), ipath));
+        let map =
+            regime::regime_map(&points, &cfg.fit, description(cfg, &format!("grid, angle {angle} deg")));
+        if ai == 0 {
+            if let Some(m) = &map {
+                let jpath = ctx.dir.path("regime_map.json");
+                output::write_regime_map(&jpath, m)?;
+                s.artifacts.push(("wall rule (regime_map.json)".into(), jpath));
+                s.headline.push(fit_line("v_crit(d)", &m.v_crit_of_d));
+                s.headline.push(fit_line("d_crit(v_n)", &m.d_crit_of_vn));
+            } else {
+                s.headline
+                    .push("no stick/bounce interface inside the grid: no regime_map.json written".into());
+            }
+        }
+        let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
+        let chart = output::regime_chart(&title, recs, &points, map.as_ref().map(|m| &m.v_crit_of_d), &axes);
+        let png = output::save_chart(&chart, ctx.dir, &format!("regime_map{suffix}"), cfg.svg)?;
+        s.artifacts.push((format!("regime map picture at {angle} deg"), png));
+        s.headline.push(format!(
+            "angle {angle} deg: {} of {} impacts stick; interface at {} diameters, {} stick at every speed, {} bounce at every speed{}",
+            regime::stick_count(recs),
+            recs.len(),
+            iface.points.len(),
+            iface.all_stick.len(),
+            iface.all_bounce.len(),
+            if iface.non_monotone.is_empty() {
+                String::new()
+            } else {
+                format!(", {} with more than one transition", iface.non_monotone.len())
+            }
+        ));
+    }
+    Ok(s)
+}
+
+fn fit_line(name: &str, f: &spatter_core::regime::PolyFit) -> String {
+    format!(
+        "fit {name} ({}log10 polynomial, degree {}): coefficients {:?} on [{:.4e}, {:.4e}], rms relative error {:.3} %",
+        if f.log10 { "" } else { "non-" },
+        f.coefficients.len() - 1,
+        f.coefficients,
+        f.x_range[0],
+        f.x_range[1],
+        100.0 * f.rms_relative_error
+    )
+}
+
+fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    let ds = cfg.grid.diameter_axis();
+    let (v_lo, v_hi) = cfg.grid.speed_range();
+    let lo = cfg.bisection.speed_low_m_s.unwrap_or(v_lo);
+    let hi = cfg.bisection.speed_high_m_s.unwrap_or(v_hi);
+    let model = model_of(cfg);
+    let mut p = load_progress(cfg, ctx)?;
+    ctx.control.status("snow regime map: bisection");
+    let tol = cfg.bisection.relative_tolerance;
+    let exp = cfg.bisection.max_expansions;
+    if run_chunks(
+        &ds,
+        &mut p.critical,
+        chunk_size(ds.len()).min(4 * rayon::current_num_threads().max(1)),
+        ctx,
+        |&d| critical_speed(&model, d, lo, hi, tol, exp),
+    ) == Finished::Interrupted
+    {
+        return interrupted(&p, ctx, ds.len());
+    }
+    let axes = Axes::of(&cfg.grid);
+    let mut s = RunSummary::new(Finished::Completed);
+    let cpath = ctx.dir.path("critical_speeds.csv");
+    output::write_critical_speeds(&cpath, &p.critical)?;
+    s.artifacts.push(("critical speed per diameter".into(), cpath));
+    let points = regime::interface_from_bisection(&p.critical);
+    let map = regime::regime_map(&points, &cfg.fit, description(cfg, "bisection"));
+    if let Some(m) = &map {
+        let jpath = ctx.dir.path("regime_map.json");
+        output::write_regime_map(&jpath, m)?;
+        s.artifacts.push(("wall rule (regime_map.json)".into(), jpath));
+        s.headline.push(fit_line("v_crit(d)", &m.v_crit_of_d));
+        s.headline.push(fit_line("d_crit(v_n)", &m.d_crit_of_vn));
+    }
+    let pts: Vec<(f64, f64)> = points.iter().map(|q| (axes.v(q[1]), axes.d(q[0]))).collect();
+    let mut chart = Chart::new("Critical normal speed by bisection", &axes.v_label(), &axes.d_label())
+        .markers("v_crit (bisection)", &pts, output::STICK_RGB);
+    if let Some(m) = &map {
+        chart =
+            chart.line_colored("fitted boundary", &output::fit_curve(&m.v_crit_of_d, &axes), INTERFACE_RGB);
+    }
+    let png = output::save_chart(&chart, ctx.dir, "critical_speed", cfg.svg)?;
+    s.artifacts.push(("critical speed picture".into(), png));
+    let impacts: u32 = p.critical.iter().map(|c| c.impacts).sum();
+    let found = points.len();
+    s.headline.push(format!(
+        "bisection: v_crit found for {found} of {} diameters with {impacts} impacts (relative tolerance {tol})",
+        ds.len()
+    ));
+    if let (Some(a), Some(b)) = (points.first(), points.last()) {
+        s.headline.push(format!(
+            "v_crit = {:.4} m/s at d = {:.3e} m, {:.4} m/s at d = {:.3e} m",
+            a[1], a[0], b[1], b[0]
+        ));
+    }
+    // The stick count an equivalent grid would give (speeds k·Δv, one transition per diameter).
+    let vs = cfg.grid.speed_axis();
+    let grid_count: usize = p
+        .critical
+        .iter()
+        .map(|c| {
+            vs.iter()
+                .filter(|&&v| v < c.v_crit || c.v_crit.is_nan() && c.low.is_finite() && v <= c.low)
+                .count()
+        })
+        .sum();
+    s.headline.push(format!("equivalent grid stick count ({} speeds): {grid_count}", vs.len()));
+    Ok(s)
+}
+
+fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    let cases = &cfg.sensitivity.cases;
+    let base_jobs = grid_jobs(&cfg.grid);
+    let models: Vec<ImpactModel> = cases.iter().map(|c| model_of(&case_config(cfg, c))).collect();
+    let jobs: Vec<(usize, usize)> =
+        (0..cases.len()).flat_map(|c| (0..base_jobs.len()).map(move |j| (c, j))).collect();
+    let mut p = load_progress(cfg, ctx)?;
+    ctx.control.status("snow regime map: sensitivity study");
+    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, |&(c, j)| {
+        run_job(&models[c], &base_jobs[j])
+    }) == Finished::Interrupted
+    {
+        return interrupted(&p, ctx, jobs.len());
+    }
+    let axes = Axes::of(&cfg.grid);
+    let mut s = RunSummary::new(Finished::Completed);
+    let n = base_jobs.len();
+    let sets: Vec<(usize, &[ImpactRecord])> =
+        (0..cases.len()).map(|c| (c, &p.records[c * n..(c + 1) * n])).collect();
+    let ipath = ctx.dir.path("sensitivity_impacts.csv");
+    output::write_impacts(&ipath, &sets)?;
+    s.artifacts.push(("every impact of every case".into(), ipath));
+    let (n_d, n_v) = (cfg.grid.diameters, cfg.grid.normal_speeds);
+    let mut rows = Vec::new();
+    let mut chart = Chart::new(
+        "Sensitivity study: stick/bounce boundaries (stick left of each line)",
+        &axes.v_label(),
+        &axes.d_label(),
+    );
+    s.headline.push(format!("{:<20} {:>8} {:>8}", "case", "sticks", "thesis"));
+    for (c, case) in cases.iter().enumerate() {
+        let recs = sets[c].1;
+        let count = regime::stick_count(recs);
+        let iface = regime::interface(recs, n_d, n_v, 0);
+        let pts: Vec<(f64, f64)> = iface.points.iter().map(|q| (axes.v(q[1]), axes.d(q[0]))).collect();
+        chart = chart.line_colored(&format!("{} ({count})", case.name), &pts, output::case_colour(c));
+        let cc = case_config(cfg, case);
+        let sy = match cc.contact.restitution {
+            RestitutionModel::Thornton { yield_stress_pa, .. } => yield_stress_pa,
+            RestitutionModel::Constant { .. } => f64::NAN,
+        };
+        rows.push(vec![
+            case.name.clone(),
+            format!("{}", cc.particle.youngs_modulus),
+            format!("{}", cc.particle.poisson_ratio),
+            format!("{}", cc.contact.work_of_adhesion_j_m2),
+            format!("{sy}"),
+            format!("{count}"),
+            case.thesis_sticks.map_or(String::new(), |t| t.to_string()),
+            format!("{}", recs.len()),
+        ]);
+        s.headline.push(format!(
+            "{:<20} {:>8} {:>8}",
+            case.name,
+            count,
+            case.thesis_sticks.map_or("-".to_string(), |t| t.to_string())
+        ));
+        let map_chart =
+            output::regime_chart(&format!("Regime map: {}", case.name), recs, &iface.points, None, &axes);
+        output::save_chart(&map_chart, ctx.dir, &format!("maps/case{c}"), false)?;
+        if c == 0 {
+            if let Some(m) =
+                regime::regime_map(&iface.points, &cfg.fit, description(cfg, "sensitivity baseline"))
+            {
+                let jpath = ctx.dir.path("regime_map.json");
+                output::write_regime_map(&jpath, &m)?;
+                s.artifacts.push(("baseline wall rule (regime_map.json)".into(), jpath));
+            }
+        }
+    }
+    let tpath = ctx.dir.path("sensitivity.csv");
+    spatter_io::csv::write_table(
+        &tpath,
+        &[
+            "case",
+            "particle_youngs_modulus_pa",
+            "particle_poisson_ratio",
+            "work_of_adhesion_j_m2",
+            "yield_stress_pa",
+            "sticks",
+            "thesis_sticks",
+            "impacts",
+        ],
+        &rows,
+    )?;
+    s.artifacts.push(("stick counts beside the thesis".into(), tpath));
+    let png = output::save_chart(&chart, ctx.dir, "sensitivity_boundaries", cfg.svg)?;
+    s.artifacts.push(("boundaries of every case".into(), png));
+    s.headline.push(format!(
+        "velocity scale {} m/s: grid speeds {:.4}..{:.4} m/s (normalised {:.3}..{:.3})",
+        cfg.grid.velocity_scale_m_s,
+        cfg.grid.speed_range().0,
+        cfg.grid.speed_range().1,
+        cfg.grid.speed_range().0 / cfg.grid.velocity_scale_m_s,
+        cfg.grid.speed_range().1 / cfg.grid.velocity_scale_m_s
+    ));
+    Ok(s)
+}
+
+/// The rough-wall bed of `cfg`.
+pub fn make_bed(cfg: &SnowConfig) -> Bed {
+    let rw = &cfg.rough_wall;
+    let mut rng = seeded(rw.seed, u64::MAX);
+    match rw.packing {
+        Packing::RandomInsertion => random_insertion(
+            rw.bed_width(),
+            rw.bed_thickness(),
+            rw.bed_sphere_diameter_m,
+            rw.volume_fraction,
+            &mut rng,
+        ),
+        Packing::Settled => settled(
+            rw.bed_width(),
+            rw.bed_thickness(),
+            rw.bed_sphere_diameter_m,
+            rw.volume_fraction,
+            &mut rng,
+        ),
+    }
+}
+
+/// Lateral aim point of rough-wall impact `k`: uniform in the central square of half the bed width.
+pub fn aim_point(cfg: &SnowConfig, k: u64) -> [f64; 2] {
+    let mut rng = seeded(cfg.rough_wall.seed, k);
+    let half = 0.25 * cfg.rough_wall.bed_width();
+    [(rng.random::<f64>() * 2.0 - 1.0) * half, (rng.random::<f64>() * 2.0 - 1.0) * half]
+}
+
+fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    let rw = &cfg.rough_wall;
+    let bed = make_bed(cfg);
+    let speeds = rw.speed_axis(cfg.grid.velocity_scale_m_s);
+    let d = rw.particle_diameter_m;
+    let model = model_of(cfg);
+    let surface = Surface::Bed { spheres: &bed.spheres, top: bed.top, sphere_radius: bed.sphere_radius };
+    let jobs: Vec<(usize, usize)> =
+        (0..speeds.len()).flat_map(|i| (0..rw.impacts_per_speed).map(move |k| (i, k))).collect();
+    let mut p = load_progress(cfg, ctx)?;
+    ctx.control.status("snow regime map: rough wall");
+    let run_one = |&(i, k): &(usize, usize)| {
+        let aim = aim_point(cfg, (i * rw.impacts_per_speed + k) as u64);
+        let (result, setup) = model.simulate(d, speeds[i], 0.0, aim, surface);
+        ImpactRecord {
+            diameter: d,
+            normal_speed: speeds[i],
+            tangential_speed: 0.0,
+            angle_deg: 0.0,
+            aim,
+            result,
+            restitution_input: setup.restitution_input,
+            dt: setup.dt,
+            hertz_time: setup.hertz_time,
+        }
+    };
+    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, run_one) == Finished::Interrupted {
+        return interrupted(&p, ctx, jobs.len());
+    }
+    let mut s = RunSummary::new(Finished::Completed);
+    let ipath = ctx.dir.path("rough_impacts.csv");
+    output::write_impacts(&ipath, &[(0, &p.records)])?;
+    s.artifacts.push(("every rough-wall impact".into(), ipath));
+    // The bed for ParaView.
+    let centres: Vec<Vec3> = bed.spheres.iter().map(|q| Vec3::from(q.centre)).collect();
+    let radii: Vec<f64> = bed.spheres.iter().map(|q| q.radius).collect();
+    let vtu = ctx.dir.path("bed.vtu");
+    spatter_io::vtu::Vtu::point_cloud(&centres).point_scalar("radius_m", &radii).write(&vtu)?;
+    s.artifacts.push(("rough-wall bed (VTU)".into(), vtu));
+    // Flat-wall reference for the same particle.
+    let mut flat = model.clone();
+    flat.target = super::config::TargetKind::Wall;
+    let v_flat = critical_speed(&flat, d, speeds[0], speeds[speeds.len() - 1], 1e-3, 6);
+    let n = rw.impacts_per_speed;
+    let mut csv = spatter_io::csv::CsvSeries::create(
+        &ctx.dir.path("stick_probability.csv"),
+        &[
+            "normal_speed_m_s",
+            "normal_speed_norm",
+            "impacts",
+            "sticks",
+            "stick_probability",
+            "wilson_low",
+            "wilson_high",
+        ],
+    )?;
+    let (mut est, mut lo_pts, mut hi_pts) = (Vec::new(), Vec::new(), Vec::new());
+    let v_scale = cfg.grid.velocity_scale_m_s;
+    let mut any_stick_max: Option<f64> = None;
+    for (i, &v) in speeds.iter().enumerate() {
+        let k = p.records[i * n..(i + 1) * n].iter().filter(|r| r.sticks()).count();
+        let (ph, lo, hi) = wilson_interval(k, n, rw.confidence);
+        csv.row(&[v, v / v_scale, n as f64, k as f64, ph, lo, hi])?;
+        est.push((v, ph));
+        lo_pts.push((v, lo));
+        hi_pts.push((v, hi));
+        if k > 0 {
+            any_stick_max = Some(v);
+        }
+    }
+    csv.flush()?;
+    s.artifacts
+        .push(("stick probability with Wilson intervals".into(), ctx.dir.path("stick_probability.csv")));
+    let mut chart = Chart::new(
+        &format!(
+            "Stick probability on a rough wall: d = {:.3e} m on {:.3e} m spheres",
+            d, rw.bed_sphere_diameter_m
+        ),
+        "normal impact speed [m/s]",
+        "stick probability",
+    )
+    .log_x()
+    .y_range(-0.02, 1.02)
+    .line_colored("estimate", &est, output::STICK_RGB)
+    .markers("", &est, output::STICK_RGB)
+    .dashed(&format!("Wilson {} % interval", 100.0 * rw.confidence), &lo_pts, (120, 120, 120))
+    .dashed("", &hi_pts, (120, 120, 120));
+    if v_flat.v_crit.is_finite() {
+        chart = chart.dashed(
+            "flat-wall v_crit",
+            &[(v_flat.v_crit, 0.0), (v_flat.v_crit, 1.0)],
+            output::BOUNCE_RGB,
+        );
+    }
+    let png = output::save_chart(&chart, ctx.dir, "stick_probability", cfg.svg)?;
+    s.artifacts.push(("stick probability picture".into(), png));
+    s.headline.push(format!(
+        "rough wall: {} spheres of {:.3e} m ({:?}, nominal volume fraction {:.3}), bed top {:.3e} m, width {:.3e} m",
+        bed.spheres.len(),
+        rw.bed_sphere_diameter_m,
+        rw.packing,
+        bed.nominal_fraction,
+        bed.top,
+        bed.width
+    ));
+    s.headline.push(format!(
+        "{} impacts per speed at {} speeds; highest speed with a stick: {}; flat-wall v_crit for the same particle {:.4} m/s",
+        n,
+        speeds.len(),
+        any_stick_max.map_or("none".into(), |v| format!("{v:.4} m/s ({:.4} normalised)", v / v_scale)),
+        v_flat.v_crit
+    ));
+    Ok(s)
+}
