@@ -43,8 +43,10 @@ impl CliControl {
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let stop_after =
-            std::env::var("SPATTER_STOP_AFTER_POLLS").ok().and_then(|v| v.parse().ok()).map(StopAfterPolls::new);
+        let stop_after = std::env::var("SPATTER_STOP_AFTER_POLLS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .map(StopAfterPolls::new);
         if std::env::var("SPATTER_NO_PROGRESS").is_ok() {
             bar.set_draw_target(ProgressDrawTarget::hidden());
         }
