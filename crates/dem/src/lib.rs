@@ -9,8 +9,10 @@ pub mod insertion;
 pub mod par;
 pub mod particles;
 pub mod sim;
+pub mod validation;
 pub mod walls;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};
 pub use sim::{EnergyReport, Integrator, Settings, Simulation};
+pub use validation::validation_cases;

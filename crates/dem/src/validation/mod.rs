@@ -1,0 +1,71 @@
+//! Verification cases of `spatter validate`: Chung & Ooi (2011) tests 1–8 (tests 2, 3, 4 and 6 also
+//! against an STL plane with the impact on a face, a shared edge and a shared vertex), energy
+//! conservation of an elastic gas, and a settled pile.
+
+pub mod bulk;
+pub mod chung_ooi;
+pub mod impact;
+
+use spatter_core::validation::Case;
+
+/// Every DEM validation case; `run(true)` is the quick variant that CI runs.
+pub fn validation_cases() -> Vec<Case> {
+    vec![
+        Case { name: "chung_ooi_1_two_spheres_elastic", run: chung_ooi::test1 },
+        Case { name: "chung_ooi_2_sphere_plane_elastic", run: chung_ooi::test2 },
+        Case { name: "chung_ooi_3_restitution", run: chung_ooi::test3 },
+        Case { name: "chung_ooi_4_oblique_impact", run: chung_ooi::test4 },
+        Case { name: "chung_ooi_5_small_sphere_sliding", run: chung_ooi::test5 },
+        Case { name: "chung_ooi_6_spinning_sphere_on_plane", run: chung_ooi::test6 },
+        Case { name: "chung_ooi_7_opposite_spins", run: chung_ooi::test7 },
+        Case { name: "chung_ooi_8_small_on_large_sphere", run: chung_ooi::test8 },
+        Case { name: "dem_elastic_box_energy", run: bulk::elastic_box },
+        Case { name: "dem_settled_pile", run: bulk::settled_pile },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn print_and_count(case: &Case, quick: bool) -> usize {
+        let checks = (case.run)(quick);
+        assert!(!checks.is_empty(), "{} produced no checks", case.name);
+        let mut failed = 0;
+        for c in &checks {
+            let flag = if c.passed() { "ok  " } else { "FAIL" };
+            println!(
+                "{flag} {:40} {:42} ref {:>12.5e} ours {:>12.5e} err {:.2e}",
+                c.case,
+                c.quantity,
+                c.reference,
+                c.ours,
+                c.error()
+            );
+            if !c.passed() {
+                failed += 1;
+            }
+        }
+        failed
+    }
+
+    #[test]
+    fn quick_validation_cases_pass() {
+        let mut failed = 0;
+        for case in validation_cases() {
+            failed += print_and_count(&case, true);
+        }
+        assert_eq!(failed, 0, "{failed} validation checks failed (run with --nocapture)");
+    }
+
+    /// The full set, as `spatter validate` runs it.
+    #[test]
+    #[ignore]
+    fn full_validation_cases_pass() {
+        let mut failed = 0;
+        for case in validation_cases() {
+            failed += print_and_count(&case, false);
+        }
+        assert_eq!(failed, 0, "{failed} validation checks failed");
+    }
+}
