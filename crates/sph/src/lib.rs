@@ -1,1 +1,32 @@
-//! Weakly compressible SPH engine for free-surface water.
+//! Weakly compressible SPH engine for free-surface water with moving rigid bodies, surface tension,
+//! adhesion, air drag, wetting and splash sensors.
+//!
+//! * [`kernel`], [`eos`], [`params`] — kernels (Wendland C2, cubic spline, Akinci splines), Tait equation
+//!   of state, physical and numerical parameters;
+//! * [`fluid`], [`boundary`] — particle storage; walls sampled from boxes and meshes, moving by
+//!   [`spatter_core::motion::KinematicTree`];
+//! * [`neighbours`], `pass` — cell-list neighbour loops (wall extrapolation, forces, continuity);
+//! * [`guard`] — no particle crosses a wall, however thin;
+//! * [`fill`] — fluid initialisation on a lattice (box minus solids, flood fill);
+//! * [`drag`] — air drag;
+//! * [`sim`] — the [`Simulation`] and its time step (velocity Verlet with one force evaluation per step).
+//!
+//! See `docs/sph.md` for the equations, defaults and references.
+
+pub mod boundary;
+pub mod drag;
+pub mod eos;
+pub mod error;
+pub mod fill;
+pub mod fluid;
+pub mod guard;
+pub mod kernel;
+pub mod neighbours;
+pub mod params;
+mod pass;
+pub mod sim;
+
+pub use error::SphError;
+pub use kernel::{Dim, KernelKind};
+pub use params::SphParams;
+pub use sim::Simulation;

@@ -1,0 +1,1083 @@
+//! The simulation state, its set-up and the time step.
+//!
+//! **Time integration** — velocity Verlet (kick–drift–kick) with one force evaluation per step:
+//! `x ← x + dt (v + ½dt a)`, `v* = v + dt a`, `ρ* = ρ + dt Dρ`; forces `a'`, `Dρ'` are evaluated at
+//! `(x, v*, ρ*)`; then `v ← v* + ½dt (a' − a)`, `ρ ← ρ* + ½dt (Dρ' − Dρ)`. For velocity-independent forces
+//! this is the symplectic velocity Verlet scheme; velocity-dependent terms (viscosity, continuity) use the
+//! predicted velocity.
+//!
+//! **Time step** (logged with every output) — `dt = min(C h/(c_max + v_max), C √(h/a_max), 0.125 h²/ν,
+//! dt_max)` with the Courant number `C` (Monaghan 1992; Crespo et al. 2015), `c_max` the largest Tait sound
+//! speed, `v_max` the largest fluid speed plus the largest wall speed.
+//!
+//! **Each step**: predictor and drift → wall kinematics at the new time → crossing guard → periodic wrap →
+//! removal of particles outside the domain box or the density window (counted, never fatal) and a
+//! finiteness check (a blow-up stops with the particle, step and time) → re-sort by cell → periodic images
+//! → wall state (Adami extrapolation, wetting) → surface normals (with surface tension) → forces →
+//! corrector → next time step.
+
+use crate::boundary::{
+    block_lattice, box_surface, mesh_samples, tank_lattice, Boundary, Faces, Frame, Sampling, Slip,
+};
+use crate::error::SphError;
+use crate::fill::{fill_box, flood_fill, Clearance};
+use crate::fluid::{Fluid, PermuteScratch};
+use crate::guard::guard_particle;
+use crate::kernel::{Dim, Kernel};
+use crate::neighbours::NeighbourGrid;
+use crate::params::SphParams;
+use crate::pass::{self, Consts, FluidOut, FluidSet, PassStats, WallSet};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use spatter_core::mesh::TriMesh;
+use spatter_core::motion::{KinematicTree, Motion};
+use spatter_core::{Aabb, Vec3};
+
+/// Wall properties shared by every kind of part.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WallOptions {
+    /// Akinci adhesion β as a multiple of the cohesion γ (0: none).
+    pub adhesion: f64,
+    pub slip: Slip,
+}
+
+impl Default for WallOptions {
+    fn default() -> Self {
+        WallOptions { adhesion: 0.0, slip: Slip::NoSlip }
+    }
+}
+
+/// Particles removed so far, by reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Removed {
+    pub outside_domain: u64,
+    pub density_window: u64,
+}
+
+/// Numbers of the last step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepStats {
+    pub max_speed: f64,
+    pub max_acc: f64,
+    pub max_density_ratio: f64,
+    pub min_density_ratio: f64,
+    pub interactions: u64,
+    /// Particles stopped by the crossing guard in the last step.
+    pub guard_hits: u64,
+    pub dt_acoustic: f64,
+    pub dt_force: f64,
+    pub dt_viscous: f64,
+}
+
+/// Fluid force and torque on one part \[N, N m; per metre of depth in 2D\].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PartLoad {
+    pub force: Vec3,
+    /// About the part's torque point (moving with the part).
+    pub torque: Vec3,
+}
+
+/// Scratch buffers rebuilt from the state; never part of a checkpoint.
+#[derive(Clone, Debug, Default)]
+struct Work {
+    grid: NeighbourGrid,
+    perm: PermuteScratch,
+    perm_buf: Vec<u32>,
+    pos_old: Vec<Vec3>,
+    press: Vec<f64>,
+    pr: Vec<f64>,
+    nrm: Vec<Vec3>,
+    acc_new: Vec<Vec3>,
+    drho_new: Vec<f64>,
+    keep: Vec<bool>,
+    frames_old: Vec<Frame>,
+    // Periodic images of fluid particles.
+    g_src: Vec<u32>,
+    g_pos: Vec<Vec3>,
+    g_vel: Vec<Vec3>,
+    g_rho: Vec<f64>,
+    g_pr: Vec<f64>,
+    g_press: Vec<f64>,
+    g_nrm: Vec<Vec3>,
+    g_grid: NeighbourGrid,
+    g_tmp_u: Vec<u32>,
+    g_tmp_v: Vec<Vec3>,
+    // Wall particles (with periodic images) in cell order.
+    w_src: Vec<u32>,
+    w_ghost: Vec<bool>,
+    w_pos: Vec<Vec3>,
+    w_vel: Vec<Vec3>,
+    w_acc: Vec<Vec3>,
+    w_vvisc: Vec<Vec3>,
+    w_rho: Vec<f64>,
+    w_pr: Vec<f64>,
+    w_vol: Vec<f64>,
+    w_part: Vec<u16>,
+    w_wet: Vec<bool>,
+    w_load: Vec<Vec3>,
+    w_grid: NeighbourGrid,
+    w_tmp_u: Vec<u32>,
+    w_tmp_b: Vec<bool>,
+    w_tmp_v: Vec<Vec3>,
+    ready: bool,
+}
+
+/// A weakly compressible SPH simulation.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Simulation {
+    pub params: SphParams,
+    pub tree: KinematicTree,
+    pub fluid: Fluid,
+    pub boundary: Boundary,
+    /// Particles leaving this box are removed (periodic axes wrap instead).
+    pub domain: Aabb,
+    pub periodic: [bool; 3],
+    pub time: f64,
+    pub steps: u64,
+    /// Time step of the next step \[s\].
+    pub dt: f64,
+    pub removed: Removed,
+    pub next_id: u32,
+    pub last: StepStats,
+    /// Heights of horizontal planes counting volume crossing them (see [`Simulation::set_flux_planes`]).
+    pub flux_planes: Vec<f64>,
+    /// Volume that crossed each plane upwards / downwards since the counters were reset \[m³, m² in 2D\].
+    pub flux_up: Vec<f64>,
+    pub flux_down: Vec<f64>,
+    initialized: bool,
+    #[serde(skip)]
+    work: Work,
+}
+
+impl Simulation {
+    pub fn new(params: SphParams) -> Self {
+        Simulation {
+            params,
+            tree: KinematicTree::new(),
+            fluid: Fluid::default(),
+            boundary: Boundary::default(),
+            domain: Aabb::EMPTY,
+            periodic: [false; 3],
+            time: 0.0,
+            steps: 0,
+            dt: 0.0,
+            removed: Removed::default(),
+            next_id: 0,
+            last: StepStats::default(),
+            flux_planes: Vec::new(),
+            flux_up: Vec::new(),
+            flux_down: Vec::new(),
+            initialized: false,
+            work: Work::default(),
+        }
+    }
+
+    pub fn kernel(&self) -> Kernel {
+        self.params.kernel()
+    }
+
+    /// Default number of lattice wall layers: enough to fill the kernel support.
+    pub fn default_layers(&self) -> usize {
+        (self.kernel().support() / self.params.spacing).ceil() as usize
+    }
+
+    /// Adds a body motion to the kinematic tree (relative to `parent`); returns its node.
+    pub fn add_motion(&mut self, motion: Motion, parent: Option<usize>) -> usize {
+        self.tree.add(motion, parent)
+    }
+
+    /// A container with fluid inside `inner` and lattice walls behind the `closed` faces.
+    pub fn add_tank(
+        &mut self,
+        name: &str,
+        inner: Aabb,
+        closed: Faces,
+        layers: Option<usize>,
+        node: Option<usize>,
+        w: WallOptions,
+    ) -> usize {
+        let (dp, dim) = (self.params.spacing, self.params.dim);
+        let layers = layers.unwrap_or_else(|| self.default_layers());
+        let s = tank_lattice(inner, closed, layers, dp, dim);
+        let surface = box_surface(inner, closed, true, dim);
+        self.boundary.add_part(name, node, s, surface, Sampling::Lattice, w.adhesion, w.slip, false)
+    }
+
+    /// A solid box (fluid outside) with `layers` lattice layers inside its faces.
+    pub fn add_block(
+        &mut self,
+        name: &str,
+        block: Aabb,
+        layers: Option<usize>,
+        node: Option<usize>,
+        w: WallOptions,
+    ) -> usize {
+        let (dp, dim) = (self.params.spacing, self.params.dim);
+        let layers = layers.unwrap_or_else(|| self.default_layers());
+        let s = block_lattice(block, layers, dp, dim);
+        let surface = box_surface(block, [true; 6], false, dim);
+        self.boundary.add_part(
+            name,
+            node,
+            s,
+            surface,
+            Sampling::Mesh(Default::default()),
+            w.adhesion,
+            w.slip,
+            true,
+        );
+        let k = self.boundary.parts.len() - 1;
+        self.boundary.parts[k].sampling = Sampling::Lattice;
+        k
+    }
+
+    /// A triangle-mesh wall or body (3D only), sampled at the spacing: one layer on the surface plus
+    /// `layers − 1` behind it (against the normals).
+    pub fn add_mesh(
+        &mut self,
+        name: &str,
+        mesh: TriMesh,
+        layers: usize,
+        node: Option<usize>,
+        w: WallOptions,
+    ) -> Result<usize, SphError> {
+        if self.params.dim == Dim::Two {
+            return Err(SphError::Setup(format!("mesh part `{name}`: meshes need a 3D simulation")));
+        }
+        if mesh.triangles.is_empty() {
+            return Err(SphError::Setup(format!("mesh part `{name}` has no triangles")));
+        }
+        let seed = 0x5350_4800 + self.boundary.parts.len() as u64;
+        let (s, cov) = mesh_samples(&mesh, self.params.spacing, layers.max(1), seed);
+        let topo = mesh.topology();
+        let closed = !topo.edge_use_count.is_empty() && topo.edge_use_count.iter().all(|&c| c == 2);
+        Ok(self.boundary.add_part(name, node, s, mesh, Sampling::Mesh(cov), w.adhesion, w.slip, closed))
+    }
+
+    /// Sets the domain box; particles leaving it are removed and counted.
+    pub fn set_domain(&mut self, b: Aabb) {
+        self.domain = b;
+    }
+
+    /// Makes axis `axis` (0 = x, 1 = y, 2 = z) periodic over the domain box's extent along it.
+    pub fn set_periodic(&mut self, axis: usize) {
+        self.periodic[axis] = true;
+    }
+
+    /// Counts volume crossing the horizontal planes `z = heights[k]` (upward and downward separately).
+    pub fn set_flux_planes(&mut self, heights: Vec<f64>) {
+        self.flux_up = vec![0.0; heights.len()];
+        self.flux_down = vec![0.0; heights.len()];
+        self.flux_planes = heights;
+    }
+
+    fn add_fluid_points(&mut self, pts: &[Vec3], vel: Vec3, hydrostatic: bool) -> usize {
+        let eos = self.params.eos();
+        let g = self.params.gravity;
+        let gl = g.length();
+        // Free surface: the highest particle (against gravity) plus half a spacing.
+        let top = if gl > 0.0 && hydrostatic {
+            let up = -g / gl;
+            pts.iter().map(|p| p.dot(up)).fold(f64::NEG_INFINITY, f64::max) + 0.5 * self.params.spacing
+        } else {
+            0.0
+        };
+        let shifting = self.params.shifting > 0.0;
+        for p in pts {
+            let rho = if gl > 0.0 && hydrostatic {
+                let depth = top - p.dot(-g / gl);
+                eos.density(self.params.rest_density * gl * depth)
+            } else {
+                self.params.rest_density
+            };
+            self.fluid.push(*p, vel, rho, self.next_id, shifting);
+            self.next_id += 1;
+        }
+        pts.len()
+    }
+
+    /// Fills `region` with fluid on the lattice `region.min + (i + ½)·dp`, skipping solids and keeping the
+    /// default clearance from walls; densities hydrostatic below the top of the fill when `hydrostatic`.
+    pub fn fill_box(&mut self, region: Aabb, vel: Vec3, hydrostatic: bool) -> usize {
+        let pts = fill_box(
+            &self.boundary,
+            region,
+            self.params.spacing,
+            self.params.dim,
+            Clearance::for_spacing(self.params.spacing),
+        );
+        self.add_fluid_points(&pts, vel, hydrostatic)
+    }
+
+    /// Flood-fills the lattice of `region` from `seed` without crossing walls.
+    pub fn flood_fill(
+        &mut self,
+        seed: Vec3,
+        region: Aabb,
+        vel: Vec3,
+        hydrostatic: bool,
+    ) -> Result<usize, SphError> {
+        let pts = flood_fill(
+            &self.boundary,
+            seed,
+            region,
+            self.params.spacing,
+            self.params.dim,
+            Clearance::for_spacing(self.params.spacing),
+        )
+        .map_err(SphError::Setup)?;
+        Ok(self.add_fluid_points(&pts, vel, hydrostatic))
+    }
+
+    /// Adds fluid particles at given points (density ρ₀).
+    pub fn add_particles(&mut self, pts: &[Vec3], vel: Vec3) -> usize {
+        self.add_fluid_points(pts, vel, false)
+    }
+
+    /// Prepares the run: wall volumes, placement at the current time, the first force evaluation and
+    /// time step. Call once after set-up.
+    pub fn initialize(&mut self) -> Result<(), SphError> {
+        if self.fluid.is_empty() {
+            return Err(SphError::Setup("no fluid particles: fill a region or add particles".into()));
+        }
+        if self.domain.is_empty() {
+            let mut b = Aabb::from_points(&self.fluid.pos).union(Aabb::from_points(&self.boundary.ref_pos));
+            let margin = (0.1 * b.extent().max_element()).max(10.0 * self.params.spacing);
+            b = b.inflated(margin);
+            self.domain = b;
+        }
+        for a in 0..3 {
+            if self.periodic[a] {
+                let len = self.domain.max[a] - self.domain.min[a];
+                if len.is_nan() || len <= 2.0 * self.kernel().support() {
+                    return Err(SphError::Setup(format!(
+                        "periodic axis {a}: the domain length {len} m must exceed two kernel supports ({} m)",
+                        2.0 * self.kernel().support()
+                    )));
+                }
+            }
+        }
+        let kernel = self.kernel();
+        self.boundary.compute_volumes(&kernel, self.params.spacing);
+        self.boundary.update_kinematics(&self.tree, self.time);
+        if self.flux_up.len() != self.flux_planes.len() {
+            self.flux_up = vec![0.0; self.flux_planes.len()];
+            self.flux_down = vec![0.0; self.flux_planes.len()];
+        }
+        self.prepare_sets();
+        let st = self.passes(0.0);
+        let n = self.fluid.len();
+        self.fluid.acc[..n].copy_from_slice(&self.work.acc_new[..n]);
+        self.fluid.drho[..n].copy_from_slice(&self.work.drho_new[..n]);
+        self.update_dt(st);
+        self.initialized = true;
+        Ok(())
+    }
+
+    /// Rebuilds every scratch structure from the state (after loading a checkpoint). Changes no state.
+    pub fn refresh(&mut self) {
+        self.boundary.update_kinematics(&self.tree, self.time);
+        self.prepare_sets();
+        self.wall_state_only();
+    }
+
+    fn consts(&self, dt: f64) -> Consts {
+        let p = &self.params;
+        let k = self.kernel();
+        let eos = p.eos();
+        let gamma_st = p.cohesion_coefficient();
+        let support = k.support();
+        let d = p.dim.count();
+        Consts {
+            dim: p.dim,
+            m: p.mass(),
+            h: k.h,
+            support,
+            r2max: support * support,
+            c0: p.sound_speed,
+            rho0: p.rest_density,
+            alpha: p.artificial_viscosity,
+            eta2: 0.01 * k.h * k.h,
+            nu: p.kinematic_viscosity,
+            dc: 2.0 * p.density_diffusion * k.h * p.sound_speed,
+            gk: p.gravity * (p.rest_density / (p.sound_speed * p.sound_speed)),
+            g: p.gravity,
+            gamma_st,
+            curv: p.curvature_weight * (2.0 * p.spacing / support).powi(d),
+            beta: self.boundary.parts.iter().map(|q| q.adhesion * gamma_st).collect(),
+            drag: p.drag,
+            shift_a: p.shifting,
+            dt,
+            spacing: p.spacing,
+            w0: k.w0(),
+            eos_b: eos.stiffness(),
+            eos_gamma: p.gamma,
+            wet_d2: p.wet_distance * p.wet_distance,
+            slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
+        }
+    }
+
+    /// Sorts the fluid by cell, computes pressures, periodic images and the wall set.
+    fn prepare_sets(&mut self) {
+        let support = self.kernel().support();
+        let w = &mut self.work;
+        w.grid.rebuild(&self.fluid.pos, support);
+        // After permuting, the grid's cell ranges index the sorted arrays directly.
+        let identity = w.grid.entries().iter().enumerate().all(|(k, &i)| k == i as usize);
+        if !identity {
+            w.perm_buf.clear();
+            w.perm_buf.extend_from_slice(w.grid.entries());
+            self.fluid.permute(&w.perm_buf, &mut w.perm);
+        }
+        self.compute_pressure();
+        self.build_fluid_images();
+        self.build_wall_set();
+        self.work.ready = true;
+    }
+
+    fn compute_pressure(&mut self) {
+        let eos = self.params.eos();
+        let n = self.fluid.len();
+        let w = &mut self.work;
+        w.press.resize(n, 0.0);
+        w.pr.resize(n, 0.0);
+        w.press.par_iter_mut().zip(w.pr.par_iter_mut()).zip(self.fluid.rho.par_iter()).for_each(
+            |((p, pr), &rho)| {
+                *p = eos.pressure(rho);
+                *pr = *p / (rho * rho);
+            },
+        );
+    }
+
+    /// Images of fluid particles within one support of a periodic face, shifted by the period.
+    fn build_fluid_images(&mut self) {
+        let support = self.kernel().support();
+        let w = &mut self.work;
+        w.g_src.clear();
+        w.g_pos.clear();
+        if self.periodic.iter().any(|&p| p) {
+            for a in 0..3 {
+                if !self.periodic[a] {
+                    continue;
+                }
+                let (lo, hi) = (self.domain.min[a], self.domain.max[a]);
+                let len = hi - lo;
+                // Real particles, then the images made for earlier axes (corners).
+                let n_real = self.fluid.len();
+                let n_before = w.g_pos.len();
+                for i in 0..n_real + n_before {
+                    let (x, src) = if i < n_real {
+                        (self.fluid.pos[i], i as u32)
+                    } else {
+                        (w.g_pos[i - n_real], w.g_src[i - n_real])
+                    };
+                    if x[a] < lo + support {
+                        let mut y = x;
+                        y[a] += len;
+                        w.g_pos.push(y);
+                        w.g_src.push(src);
+                    }
+                    if x[a] > hi - support {
+                        let mut y = x;
+                        y[a] -= len;
+                        w.g_pos.push(y);
+                        w.g_src.push(src);
+                    }
+                }
+            }
+        }
+        w.g_grid.rebuild(&w.g_pos, support);
+        let perm = w.g_grid.entries();
+        w.g_tmp_u.clear();
+        w.g_tmp_u.extend(perm.iter().map(|&i| w.g_src[i as usize]));
+        std::mem::swap(&mut w.g_src, &mut w.g_tmp_u);
+        w.g_tmp_v.clear();
+        w.g_tmp_v.extend(perm.iter().map(|&i| w.g_pos[i as usize]));
+        std::mem::swap(&mut w.g_pos, &mut w.g_tmp_v);
+        self.gather_image_state();
+    }
+
+    /// Copies velocity, density and pressure of the sources into the images.
+    fn gather_image_state(&mut self) {
+        let w = &mut self.work;
+        let f = &self.fluid;
+        w.g_vel.clear();
+        w.g_vel.extend(w.g_src.iter().map(|&s| f.vel[s as usize]));
+        w.g_rho.clear();
+        w.g_rho.extend(w.g_src.iter().map(|&s| f.rho[s as usize]));
+        w.g_pr.clear();
+        w.g_pr.extend(w.g_src.iter().map(|&s| w.pr[s as usize]));
+        w.g_press.clear();
+        w.g_press.extend(w.g_src.iter().map(|&s| w.press[s as usize]));
+    }
+
+    /// The wall particles (and their periodic images) in cell order.
+    fn build_wall_set(&mut self) {
+        let support = self.kernel().support();
+        let w = &mut self.work;
+        let b = &self.boundary;
+        w.w_src.clear();
+        w.w_ghost.clear();
+        w.w_pos.clear();
+        for i in 0..b.len() {
+            w.w_src.push(i as u32);
+            w.w_ghost.push(false);
+            w.w_pos.push(b.pos[i]);
+        }
+        for a in 0..3 {
+            if !self.periodic[a] {
+                continue;
+            }
+            let (lo, hi) = (self.domain.min[a], self.domain.max[a]);
+            let len = hi - lo;
+            for i in 0..w.w_pos.len() {
+                let x = w.w_pos[i];
+                for (cond, shift) in [(x[a] < lo + support, len), (x[a] > hi - support, -len)] {
+                    if cond {
+                        let mut y = x;
+                        y[a] += shift;
+                        w.w_pos.push(y);
+                        w.w_src.push(w.w_src[i]);
+                        w.w_ghost.push(true);
+                    }
+                }
+            }
+        }
+        w.w_grid.rebuild(&w.w_pos, support);
+        let perm = w.w_grid.entries();
+        w.w_tmp_u.clear();
+        w.w_tmp_u.extend(perm.iter().map(|&i| w.w_src[i as usize]));
+        std::mem::swap(&mut w.w_src, &mut w.w_tmp_u);
+        w.w_tmp_b.clear();
+        w.w_tmp_b.extend(perm.iter().map(|&i| w.w_ghost[i as usize]));
+        std::mem::swap(&mut w.w_ghost, &mut w.w_tmp_b);
+        w.w_tmp_v.clear();
+        w.w_tmp_v.extend(perm.iter().map(|&i| w.w_pos[i as usize]));
+        std::mem::swap(&mut w.w_pos, &mut w.w_tmp_v);
+        let n = w.w_src.len();
+        w.w_vel.clear();
+        w.w_vel.extend(w.w_src.iter().map(|&s| b.vel[s as usize]));
+        w.w_acc.clear();
+        w.w_acc.extend(w.w_src.iter().map(|&s| b.acc[s as usize]));
+        w.w_vol.clear();
+        w.w_vol.extend(w.w_src.iter().map(|&s| b.volume[s as usize]));
+        w.w_part.clear();
+        w.w_part.extend(w.w_src.iter().map(|&s| b.part[s as usize]));
+        w.w_vvisc.resize(n, Vec3::ZERO);
+        w.w_rho.resize(n, 0.0);
+        w.w_pr.resize(n, 0.0);
+        w.w_wet.resize(n, false);
+    }
+
+    /// Wall extrapolation only (probes and loads between steps).
+    fn wall_state_only(&mut self) {
+        let kernel = self.kernel();
+        let c = self.consts(self.dt);
+        let w = &mut self.work;
+        let fl = FluidSet {
+            pos: &self.fluid.pos,
+            vel: &self.fluid.vel,
+            rho: &self.fluid.rho,
+            pr: &w.pr,
+            press: &w.press,
+            nrm: &[],
+            grid: &w.grid,
+        };
+        let gh = FluidSet {
+            pos: &w.g_pos,
+            vel: &w.g_vel,
+            rho: &w.g_rho,
+            pr: &w.g_pr,
+            press: &w.g_press,
+            nrm: &[],
+            grid: &w.g_grid,
+        };
+        let wl = WallSet {
+            pos: &w.w_pos,
+            vel: &w.w_vel,
+            acc: &w.w_acc,
+            vvisc: &[],
+            rho: &[],
+            pr: &[],
+            vol: &w.w_vol,
+            part: &w.w_part,
+            grid: &w.w_grid,
+        };
+        pass::wall_state(&kernel, &c, wl, fl, gh, &mut w.w_rho, &mut w.w_pr, &mut w.w_vvisc, &mut w.w_wet);
+    }
+
+    /// Wall state, surface normals and the fluid pass; results in `work.acc_new`, `work.drho_new`.
+    fn passes(&mut self, dt: f64) -> PassStats {
+        let kernel = self.kernel();
+        let c = self.consts(dt);
+        self.wall_state_only();
+        let n = self.fluid.len();
+        let w = &mut self.work;
+        let st_on = c.gamma_st > 0.0;
+        if st_on {
+            w.nrm.resize(n, Vec3::ZERO);
+            let fl = FluidSet {
+                pos: &self.fluid.pos,
+                vel: &self.fluid.vel,
+                rho: &self.fluid.rho,
+                pr: &w.pr,
+                press: &w.press,
+                nrm: &[],
+                grid: &w.grid,
+            };
+            let gh = FluidSet {
+                pos: &w.g_pos,
+                vel: &w.g_vel,
+                rho: &w.g_rho,
+                pr: &w.g_pr,
+                press: &w.g_press,
+                nrm: &[],
+                grid: &w.g_grid,
+            };
+            pass::normals(&kernel, &c, fl, gh, &mut w.nrm);
+            w.g_nrm.clear();
+            w.g_nrm.extend(w.g_src.iter().map(|&s| w.nrm[s as usize]));
+        }
+        w.acc_new.resize(n, Vec3::ZERO);
+        w.drho_new.resize(n, 0.0);
+        let (nrm, g_nrm): (&[Vec3], &[Vec3]) = if st_on { (&w.nrm, &w.g_nrm) } else { (&[], &[]) };
+        let fl = FluidSet {
+            pos: &self.fluid.pos,
+            vel: &self.fluid.vel,
+            rho: &self.fluid.rho,
+            pr: &w.pr,
+            press: &w.press,
+            nrm,
+            grid: &w.grid,
+        };
+        let gh = FluidSet {
+            pos: &w.g_pos,
+            vel: &w.g_vel,
+            rho: &w.g_rho,
+            pr: &w.g_pr,
+            press: &w.g_press,
+            nrm: g_nrm,
+            grid: &w.g_grid,
+        };
+        let wl = WallSet {
+            pos: &w.w_pos,
+            vel: &w.w_vel,
+            acc: &w.w_acc,
+            vvisc: &w.w_vvisc,
+            rho: &w.w_rho,
+            pr: &w.w_pr,
+            vol: &w.w_vol,
+            part: &w.w_part,
+            grid: &w.w_grid,
+        };
+        let out = FluidOut {
+            acc: &mut w.acc_new,
+            drho: &mut w.drho_new,
+            near: &mut self.fluid.near,
+            shift: &mut self.fluid.shift,
+        };
+        pass::fluid_pass(&kernel, &c, fl, gh, wl, out)
+    }
+
+    fn update_dt(&mut self, st: PassStats) {
+        let p = &self.params;
+        let h = p.h();
+        let eos = p.eos();
+        let (mut vmax, mut rmax, mut rmin) = (0.0f64, 0.0f64, f64::INFINITY);
+        for (v, &r) in self.fluid.vel.iter().zip(&self.fluid.rho) {
+            vmax = vmax.max(v.length_squared());
+            rmax = rmax.max(r);
+            rmin = rmin.min(r);
+        }
+        let vmax = vmax.sqrt();
+        let cmax = eos.sound_speed(rmax.max(p.rest_density));
+        let vwall = self.boundary.max_speed();
+        let dt_a = p.cfl * h / (cmax + vmax + vwall);
+        let dt_f = if st.max_acc > 0.0 { p.cfl * (h / st.max_acc).sqrt() } else { f64::INFINITY };
+        let dt_v =
+            if p.kinematic_viscosity > 0.0 { 0.125 * h * h / p.kinematic_viscosity } else { f64::INFINITY };
+        self.dt = dt_a.min(dt_f).min(dt_v).min(p.max_dt);
+        self.last.max_speed = vmax;
+        self.last.max_acc = st.max_acc;
+        self.last.interactions = st.interactions;
+        self.last.max_density_ratio = rmax / p.rest_density;
+        self.last.min_density_ratio = rmin / p.rest_density;
+        self.last.dt_acoustic = dt_a;
+        self.last.dt_force = dt_f;
+        self.last.dt_viscous = dt_v;
+    }
+
+    /// Advances one time step of `self.dt`.
+    pub fn step(&mut self) -> Result<(), SphError> {
+        if !self.initialized {
+            self.initialize()?;
+        }
+        let dt = self.dt;
+        let t1 = self.time + dt;
+        // Predictor and drift.
+        self.work.pos_old.clear();
+        self.work.pos_old.extend_from_slice(&self.fluid.pos);
+        {
+            let f = &mut self.fluid;
+            let shift = &f.shift;
+            let shifting = !shift.is_empty();
+            f.pos
+                .par_iter_mut()
+                .zip(f.vel.par_iter_mut())
+                .zip(f.rho.par_iter_mut())
+                .zip(f.acc.par_iter().zip(f.drho.par_iter()))
+                .enumerate()
+                .for_each(|(i, (((x, v), rho), (a, d)))| {
+                    *x += (*v + *a * (0.5 * dt)) * dt;
+                    if shifting {
+                        *x += shift[i];
+                    }
+                    *v += *a * dt;
+                    *rho += d * dt;
+                });
+        }
+        // Walls move to the new time; the guard stops crossings.
+        self.work.frames_old.clear();
+        self.work.frames_old.extend_from_slice(&self.boundary.frames);
+        self.boundary.update_kinematics(&self.tree, t1);
+        self.last.guard_hits = self.guard();
+        self.count_flux();
+        self.wrap_and_remove()?;
+        // Forces at the new positions.
+        self.prepare_sets();
+        let st = self.passes(dt);
+        self.accumulate_wetting(dt);
+        // Corrector.
+        {
+            let w = &self.work;
+            let f = &mut self.fluid;
+            let half = 0.5 * dt;
+            f.vel.par_iter_mut().zip(f.acc.par_iter_mut()).zip(w.acc_new.par_iter()).for_each(
+                |((v, a), an)| {
+                    *v += (*an - *a) * half;
+                    *a = *an;
+                },
+            );
+            f.rho.par_iter_mut().zip(f.drho.par_iter_mut()).zip(w.drho_new.par_iter()).for_each(
+                |((r, d), dn)| {
+                    *r += (dn - *d) * half;
+                    *d = *dn;
+                },
+            );
+        }
+        self.time = t1;
+        self.steps += 1;
+        self.update_dt(st);
+        Ok(())
+    }
+
+    /// Applies the crossing guard to every particle that was near a wall; returns how many were stopped.
+    fn guard(&mut self) -> u64 {
+        let parts = &self.boundary.parts;
+        if parts.is_empty() {
+            return 0;
+        }
+        let f0s = &self.work.frames_old;
+        let f1s = &self.boundary.frames;
+        let offset = self.params.guard_offset * self.params.spacing;
+        let old = &self.work.pos_old;
+        let f = &mut self.fluid;
+        f.pos
+            .par_iter_mut()
+            .zip(f.vel.par_iter_mut())
+            .zip(f.near.par_iter())
+            .enumerate()
+            .map(|(i, ((x, v), &mask))| {
+                if mask == 0 {
+                    return 0u64;
+                }
+                let mut hit = 0;
+                for (k, part) in parts.iter().enumerate() {
+                    let bit = if k < 31 { 1u32 << k } else { 1u32 << 31 };
+                    if mask & bit == 0 {
+                        continue;
+                    }
+                    let g = guard_particle(part, &f0s[k], &f1s[k], old[i], *x, *v, offset);
+                    if g.hit {
+                        *x = g.pos;
+                        *v = g.vel;
+                        hit = 1;
+                    }
+                }
+                hit
+            })
+            .sum()
+    }
+
+    fn count_flux(&mut self) {
+        if self.flux_planes.is_empty() {
+            return;
+        }
+        let vol0 = self.params.particle_volume();
+        for (i, x) in self.fluid.pos.iter().enumerate() {
+            let (z0, z1) = (self.work.pos_old[i].z, x.z);
+            if z0 == z1 {
+                continue;
+            }
+            for (k, &zp) in self.flux_planes.iter().enumerate() {
+                if z0 < zp && z1 >= zp {
+                    self.flux_up[k] += vol0;
+                } else if z0 >= zp && z1 < zp {
+                    self.flux_down[k] += vol0;
+                }
+            }
+        }
+    }
+
+    /// Resets the plane-flux counters.
+    pub fn reset_flux(&mut self) {
+        self.flux_up.iter_mut().for_each(|v| *v = 0.0);
+        self.flux_down.iter_mut().for_each(|v| *v = 0.0);
+    }
+
+    fn wrap_and_remove(&mut self) -> Result<(), SphError> {
+        let n = self.fluid.len();
+        let d = self.domain;
+        let per = self.periodic;
+        let lo_rho = self.params.density_window[0] * self.params.rest_density;
+        let hi_rho = self.params.density_window[1] * self.params.rest_density;
+        let w = &mut self.work;
+        w.keep.clear();
+        w.keep.resize(n, true);
+        let mut removed_domain = 0;
+        let mut removed_density = 0;
+        for i in 0..n {
+            let x = &mut self.fluid.pos[i];
+            let v = self.fluid.vel[i];
+            let rho = self.fluid.rho[i];
+            let what = if !spatter_core::math::is_finite(*x) {
+                Some("position")
+            } else if !spatter_core::math::is_finite(v) {
+                Some("velocity")
+            } else if !rho.is_finite() {
+                Some("density")
+            } else {
+                None
+            };
+            if let Some(what) = what {
+                return Err(SphError::BlowUp {
+                    step: self.steps + 1,
+                    time: self.time + self.dt,
+                    id: self.fluid.id[i],
+                    what,
+                    cause: format!(
+                        "the time step ({:.3e} s) is too large for the forces, or the sound speed ({} m/s) is below \
+                         10× the flow speed; lower `cfl` or raise the sound speed",
+                        self.dt, self.params.sound_speed
+                    ),
+                });
+            }
+            for a in 0..3 {
+                if per[a] {
+                    let len = d.max[a] - d.min[a];
+                    if x[a] < d.min[a] {
+                        x[a] += len;
+                    } else if x[a] >= d.max[a] {
+                        x[a] -= len;
+                    }
+                }
+            }
+            if !d.contains(*x) {
+                w.keep[i] = false;
+                removed_domain += 1;
+            } else if rho < lo_rho || rho > hi_rho {
+                w.keep[i] = false;
+                removed_density += 1;
+            }
+        }
+        if removed_domain + removed_density > 0 {
+            self.fluid.retain(&w.keep);
+            self.removed.outside_domain += removed_domain;
+            self.removed.density_window += removed_density;
+        }
+        Ok(())
+    }
+
+    fn accumulate_wetting(&mut self, dt: f64) {
+        let w = &self.work;
+        let b = &mut self.boundary;
+        for k in 0..w.w_src.len() {
+            if w.w_ghost[k] {
+                continue;
+            }
+            let s = w.w_src[k] as usize;
+            b.wet[s] = w.w_wet[k];
+            if w.w_wet[k] {
+                b.wet_time[s] += dt;
+            }
+        }
+    }
+
+    /// Fluid force and torque on every part in the current state.
+    pub fn part_loads(&mut self) -> Vec<PartLoad> {
+        if !self.work.ready {
+            self.refresh();
+        }
+        self.compute_pressure();
+        self.gather_image_state();
+        self.wall_state_only();
+        let kernel = self.kernel();
+        let c = self.consts(self.dt);
+        let w = &mut self.work;
+        w.w_load.resize(w.w_src.len(), Vec3::ZERO);
+        let fl = FluidSet {
+            pos: &self.fluid.pos,
+            vel: &self.fluid.vel,
+            rho: &self.fluid.rho,
+            pr: &w.pr,
+            press: &w.press,
+            nrm: &[],
+            grid: &w.grid,
+        };
+        let gh = FluidSet {
+            pos: &w.g_pos,
+            vel: &w.g_vel,
+            rho: &w.g_rho,
+            pr: &w.g_pr,
+            press: &w.g_press,
+            nrm: &[],
+            grid: &w.g_grid,
+        };
+        let wl = WallSet {
+            pos: &w.w_pos,
+            vel: &w.w_vel,
+            acc: &w.w_acc,
+            vvisc: &w.w_vvisc,
+            rho: &w.w_rho,
+            pr: &w.w_pr,
+            vol: &w.w_vol,
+            part: &w.w_part,
+            grid: &w.w_grid,
+        };
+        pass::wall_loads(&kernel, &c, wl, fl, gh, &mut w.w_load);
+        let mut loads = vec![PartLoad::default(); self.boundary.parts.len()];
+        let centres: Vec<Vec3> = self
+            .boundary
+            .parts
+            .iter()
+            .enumerate()
+            .map(|(k, p)| self.boundary.frames[k].to_world(p.torque_point))
+            .collect();
+        for k in 0..w.w_src.len() {
+            if w.w_ghost[k] {
+                continue;
+            }
+            let part = w.w_part[k] as usize;
+            loads[part].force += w.w_load[k];
+            loads[part].torque += (w.w_pos[k] - centres[part]).cross(w.w_load[k]);
+        }
+        loads
+    }
+
+    /// Shepard-interpolated pressure \[Pa\] and velocity at `x` (None where no fluid is near).
+    pub fn probe(&mut self, x: Vec3) -> Option<(f64, Vec3)> {
+        if !self.work.ready {
+            self.refresh();
+        }
+        self.compute_pressure();
+        self.gather_image_state();
+        let kernel = self.kernel();
+        let c = self.consts(self.dt);
+        let w = &self.work;
+        let fl = FluidSet {
+            pos: &self.fluid.pos,
+            vel: &self.fluid.vel,
+            rho: &self.fluid.rho,
+            pr: &w.pr,
+            press: &w.press,
+            nrm: &[],
+            grid: &w.grid,
+        };
+        let gh = FluidSet {
+            pos: &w.g_pos,
+            vel: &w.g_vel,
+            rho: &w.g_rho,
+            pr: &w.g_pr,
+            press: &w.g_press,
+            nrm: &[],
+            grid: &w.g_grid,
+        };
+        pass::probe(&kernel, &c, fl, gh, x)
+    }
+
+    /// Mean extrapolated wall pressure \[Pa\] of the first-layer wall particles within `radius` of `x`
+    /// (a wall pressure sensor), or None when none is in range. Uses the state of the last step.
+    pub fn wall_pressure(&mut self, x: Vec3, radius: f64) -> Option<f64> {
+        if !self.work.ready {
+            self.refresh();
+        }
+        let w = &self.work;
+        let eos = self.params.eos();
+        let (mut s, mut n) = (0.0, 0usize);
+        for k in 0..w.w_src.len() {
+            let src = w.w_src[k] as usize;
+            if w.w_ghost[k] || self.boundary.area[src] <= 0.0 {
+                continue;
+            }
+            if (w.w_pos[k] - x).length() <= radius {
+                s += eos.pressure(w.w_rho[k]);
+                n += 1;
+            }
+        }
+        (n > 0).then(|| s / n as f64)
+    }
+
+    /// Total kinetic energy of the fluid \[J, J/m in 2D\].
+    pub fn kinetic_energy(&self) -> f64 {
+        0.5 * self.params.mass() * self.fluid.vel.iter().map(|v| v.length_squared()).sum::<f64>()
+    }
+
+    /// Total fluid momentum \[kg m/s\].
+    pub fn momentum(&self) -> Vec3 {
+        self.fluid.vel.iter().copied().sum::<Vec3>() * self.params.mass()
+    }
+
+    /// Total fluid mass \[kg, kg/m in 2D\].
+    pub fn fluid_mass(&self) -> f64 {
+        self.params.mass() * self.fluid.len() as f64
+    }
+
+    /// Current pressure of every fluid particle \[Pa\] (in storage order).
+    pub fn pressures(&self) -> Vec<f64> {
+        let eos = self.params.eos();
+        self.fluid.rho.iter().map(|&r| eos.pressure(r)).collect()
+    }
+
+    /// Bytes held by the state and scratch arrays, per fluid particle (walls included in the total).
+    pub fn bytes_per_particle(&self) -> f64 {
+        use std::mem::size_of;
+        let w = &self.work;
+        let v3 = size_of::<Vec3>();
+        let scratch = w.pos_old.capacity() * v3
+            + w.press.capacity() * 8
+            + w.pr.capacity() * 8
+            + w.nrm.capacity() * v3
+            + w.acc_new.capacity() * v3
+            + w.drho_new.capacity() * 8
+            + w.keep.capacity()
+            + grid_bytes(&w.grid, self.fluid.len())
+            + perm_bytes(self.fluid.len());
+        let walls = w.w_src.capacity() * 4
+            + w.w_pos.capacity() * v3 * 4
+            + w.w_rho.capacity() * 8 * 3
+            + w.w_part.capacity() * 2
+            + w.w_wet.capacity() * 2
+            + self.boundary.len() * (v3 * 6 + 8 * 3 + 2 + 1);
+        (self.fluid.bytes() + scratch + walls) as f64 / self.fluid.len().max(1) as f64
+    }
+}
+
+fn grid_bytes(_g: &NeighbourGrid, n: usize) -> usize {
+    // Cell starts (about one cell per particle in a filled region) plus two u32 per point.
+    n * 4 + n * 8
+}
+
+fn perm_bytes(n: usize) -> usize {
+    // The permutation scratch holds one Vec3, one f64 and one u32 array.
+    n * (24 + 8 + 4)
+}
