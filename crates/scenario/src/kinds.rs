@@ -59,7 +59,10 @@ macro_rules! kinds {
     };
 }
 
-kinds! {}
+kinds! {
+    "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run),
+        "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
+}
 
 #[allow(dead_code)]
 fn resolved<T: Serialize>(kind: &str, cfg: &T) -> Result<String, String> {

@@ -295,7 +295,7 @@ impl Validate for GridConfig {
             c.positive("normal_speed_max_m_s", v);
         }
         let (lo, hi) = self.speed_range();
-        if hi < lo {
+        if self.velocity_scale_m_s > 0.0 && hi < lo {
             c.fail(
                 "normal_speed_max_m_s",
                 format!("normal_speed_max_m_s = {hi} is below the lowest speed {lo}"),
