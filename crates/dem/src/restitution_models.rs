@@ -184,6 +184,93 @@ impl Validate for RestitutionModel {
     }
 }
 
+/// A damping law for the DEM engine whose coefficient of restitution follows a [`RestitutionModel`]: when
+/// a contact forms, e is evaluated at that contact's normal impact speed (−v_rel·n) and turned into the
+/// dashpot coefficient of [`RestitutionDamping`] (same calibration and clamp options); it then stays
+/// fixed for the life of the contact, as the snow thesis did per run.
+///
+/// The yield velocity uses the pair's E* ([`PairProps::e_star`]) and the contact's R* and m*; the wall
+/// formula's density is the equivalent ρ = 3m*/(4πR*³), which is the particle's own for a wall contact.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedDependentDamping {
+    pub model: RestitutionModel,
+    /// Calibration, tensile clamp and tangential options (its pair restitution is ignored).
+    pub base: crate::contact::RestitutionDamping,
+}
+
+/// Per-pair parameters of [`SpeedDependentDamping`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedDependentParams {
+    pub e_star: f64,
+    /// Force exponent of the normal law (calibration).
+    pub exponent: f64,
+    pub clamp: bool,
+    pub tangential: bool,
+}
+
+/// Per-contact state: the dimensionless dashpot coefficient fixed at first touch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SpeedDependentState {
+    pub c_n: f64,
+}
+
+impl crate::contact::DampingLaw for SpeedDependentDamping {
+    type Params = SpeedDependentParams;
+    type State = SpeedDependentState;
+
+    fn params(&self, _pair_index: usize, props: &crate::contact::PairProps, p: f64) -> SpeedDependentParams {
+        SpeedDependentParams {
+            e_star: props.e_star,
+            exponent: p,
+            clamp: self.base.tensile_clamp,
+            tangential: self.base.tangential,
+        }
+    }
+
+    fn on_formed(
+        &self,
+        p: &SpeedDependentParams,
+        c: &crate::contact::ContactInput,
+        s: &mut SpeedDependentState,
+    ) {
+        let v = (-c.v_rel.dot(c.normal)).max(0.0);
+        let rho = 3.0 * c.m_eff / (4.0 * std::f64::consts::PI * c.r_eff.powi(3));
+        let props = ImpactProps { e_star: p.e_star, density: rho, r_star: c.r_eff, m_star: c.m_eff };
+        let e = self.model.restitution(v, &props);
+        s.c_n = self.base.coefficient(e, p.exponent);
+    }
+
+    #[inline]
+    fn normal_coefficient(
+        &self,
+        _p: &SpeedDependentParams,
+        s: &SpeedDependentState,
+        nf: &crate::contact::NormalForce,
+        c: &crate::contact::ContactInput,
+    ) -> f64 {
+        s.c_n * (c.m_eff * nf.damping_stiffness).sqrt()
+    }
+
+    #[inline]
+    fn tangential_coefficient(
+        &self,
+        p: &SpeedDependentParams,
+        s: &SpeedDependentState,
+        k_t: f64,
+        c: &crate::contact::ContactInput,
+    ) -> f64 {
+        if p.tangential {
+            s.c_n * (c.m_eff * k_t).sqrt()
+        } else {
+            0.0
+        }
+    }
+
+    fn tensile_clamp(&self, p: &SpeedDependentParams) -> bool {
+        p.clamp
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -262,6 +349,63 @@ mod tests {
         // Thesis Eq. 21: with no adhesive loss (e_a = 1) the total equals the plastic part.
         assert!((thornton_ning_additive(0.4, 1.0) - 0.4).abs() < 1e-15);
         assert_eq!(thornton_ning_additive(0.3, 0.3), 0.0);
+    }
+
+    #[test]
+    fn speed_dependent_damping_in_the_kernel() {
+        // A Hertz sphere on a wall with e(V) from Thornton: the dashpot is fixed at first touch from the
+        // impact speed, so the realised restitution of a whole impact equals e(V_impact) (LIGGGHTS damping
+        // without clamp is exact for Hertz, contact::restitution_fit). Explicit Verlet at 2000 steps per
+        // contact: tolerance 2e-3.
+        use crate::contact::{Composed, ContactInput, ContactLaw, Hertz, Mindlin, NoRolling, PairProps};
+        use crate::contact::{RestitutionCalibration, RestitutionDamping};
+        use spatter_core::material::Material;
+        use spatter_core::Vec3;
+        let ice = Material::new(9.8e9, 0.31, 920.0).unwrap();
+        let abs = Material::new(2.0e9, 0.35, 1100.0).unwrap();
+        let props = PairProps::new(&ice, &abs, 0.0, 1.0);
+        let model = RestitutionModel::default();
+        let base = RestitutionDamping {
+            tensile_clamp: false,
+            calibration: RestitutionCalibration::Linearised,
+            tangential: true,
+        };
+        let law = Composed::new(Hertz, SpeedDependentDamping { model, base }, Mindlin, NoRolling);
+        let p = law.params(0, &props);
+        let (r, rho) = (10e-6, 920.0);
+        let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * rho;
+        for v0 in [0.01, 0.5, 5.0] {
+            let expected = model
+                .restitution(v0, &ImpactProps { e_star: props.e_star, density: rho, r_star: r, m_star: m });
+            let t_c = spatter_core::timestep::hertz_time(m, r, props.e_star, v0);
+            let dt = t_c / 2000.0;
+            let (mut z, mut v) = (r, -v0);
+            let mut s = Default::default();
+            let mut f = 0.0;
+            for _ in 0..10_000 {
+                v += 0.5 * dt * f / m;
+                z += dt * v;
+                let c = ContactInput {
+                    normal: Vec3::Z,
+                    overlap: r - z,
+                    r_eff: r,
+                    m_eff: m,
+                    i_eff: 0.4 * m * r * r,
+                    v_rel: Vec3::new(0.0, 0.0, v),
+                    w_rel: Vec3::ZERO,
+                    dt,
+                };
+                f = law.compute(&p, &c, &mut s).map_or(0.0, |o| o.normal_force);
+                if f == 0.0 && z > r {
+                    s = Default::default();
+                }
+                v += 0.5 * dt * f / m;
+                if z > r && v > 0.0 {
+                    break;
+                }
+            }
+            assert!((v / v0 - expected).abs() < 2e-3, "V = {v0}: e = {} vs {expected}", v / v0);
+        }
     }
 
     #[test]
