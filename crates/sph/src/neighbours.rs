@@ -9,6 +9,17 @@ use spatter_core::grid::CellGrid;
 use spatter_core::Vec3;
 use std::ops::Range;
 
+/// `floor` without a libm call (baseline x86-64 has no rounding instruction); saturates for huge `x`.
+#[inline(always)]
+fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
 /// Cell list of one particle set, with the support radius it was built for.
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourGrid {
@@ -33,6 +44,26 @@ impl NeighbourGrid {
         self.cells.entries()
     }
 
+    /// Number of z-layers of cells.
+    pub fn layers(&self) -> usize {
+        if self.cells.entries().is_empty() {
+            0
+        } else {
+            self.cells.dims()[2]
+        }
+    }
+
+    /// First sorted index of z-layer `z` (`z = layers()` gives the number of points). Points of one layer
+    /// are contiguous in cell order, and a point's neighbours lie within two layers of its own.
+    pub fn layer_start(&self, z: usize) -> usize {
+        let [nx, ny, nz] = self.cells.dims();
+        if z >= nz {
+            self.cells.entries().len()
+        } else {
+            self.cells.cell_range(z * nx * ny).start
+        }
+    }
+
     /// Number of points binned.
     pub fn len(&self) -> usize {
         self.cells.entries().len()
@@ -42,11 +73,25 @@ impl NeighbourGrid {
         self.cells.entries().is_empty()
     }
 
+    /// Like [`for_each_run`](Self::for_each_run) but only over cells at or after the cell of `p` in cell
+    /// order (same z-layer: rows from its own y on; layers above): every point that comes after `p`'s
+    /// own cell in sorted order and lies within the support is in a returned range. Used to visit each
+    /// pair once.
+    #[inline]
+    pub fn for_each_run_after(&self, p: Vec3, f: impl FnMut(Range<usize>)) {
+        self.runs(p, true, f)
+    }
+
     /// Calls `f` with ranges of [`entries`](Self::entries) that together hold every point within the
     /// support of `p` (and some beyond it). When the set has been permuted into cell order the ranges
     /// index the set directly.
     #[inline]
-    pub fn for_each_run(&self, p: Vec3, mut f: impl FnMut(Range<usize>)) {
+    pub fn for_each_run(&self, p: Vec3, f: impl FnMut(Range<usize>)) {
+        self.runs(p, false, f)
+    }
+
+    #[inline(always)]
+    fn runs(&self, p: Vec3, after: bool, mut f: impl FnMut(Range<usize>)) {
         if self.cells.entries().is_empty() {
             return;
         }
@@ -55,15 +100,21 @@ impl NeighbourGrid {
         let r = self.support * inv;
         let [nx, ny, nz] = self.cells.dims();
         let span = |c: f64, n: usize| -> Option<(usize, usize)> {
-            let lo = (c - r).floor();
-            let hi = (c + r).floor();
+            let lo = floor(c - r);
+            let hi = floor(c + r);
             if hi < 0.0 || lo > (n - 1) as f64 || lo.is_nan() || hi.is_nan() {
                 return None;
             }
             Some((lo.max(0.0) as usize, (hi as usize).min(n - 1)))
         };
-        let Some((z0, z1)) = span(q.z, nz) else { return };
+        let Some((mut z0, z1)) = span(q.z, nz) else { return };
         let Some((y0, y1)) = span(q.y, ny) else { return };
+        // Own cell of p (clamped like the grid bins points).
+        let own = |c: f64, n: usize| (floor(c).max(0.0) as usize).min(n - 1);
+        let (oz, oy) = (own(q.z, nz), own(q.y, ny));
+        if after {
+            z0 = z0.max(oz);
+        }
         let gap = |c: f64, k: usize| (k as f64 - c).max(c - (k + 1) as f64).max(0.0);
         let r2 = r * r;
         for z in z0..=z1 {
@@ -72,15 +123,16 @@ impl NeighbourGrid {
             if rz2 < 0.0 {
                 continue;
             }
-            for y in y0..=y1 {
+            let y_from = if after && z == oz { y0.max(oy) } else { y0 };
+            for y in y_from..=y1 {
                 let dy = gap(q.y, y);
                 let rem = rz2 - dy * dy;
                 if rem < 0.0 {
                     continue;
                 }
                 let w = rem.sqrt();
-                let lo = (q.x - w).floor();
-                let hi = (q.x + w).floor();
+                let lo = floor(q.x - w);
+                let hi = floor(q.x + w);
                 if hi < 0.0 || lo > (nx - 1) as f64 {
                     continue;
                 }
@@ -136,6 +188,27 @@ mod tests {
                     (0..pts.len() as u32).filter(|&j| (pts[j as usize] - p).length() < support).collect();
                 assert_eq!(found, brute, "query {p}");
             }
+            // Half stencil: permute into cell order, then every pair (i < j) is found from i.
+            let sorted: Vec<Vec3> = g.entries().iter().map(|&k| pts[k as usize]).collect();
+            let mut pairs = 0usize;
+            for (i, p) in sorted.iter().enumerate() {
+                g.for_each_run_after(*p, |r| {
+                    let from = r.start.max(i + 1);
+                    pairs += sorted[from.min(r.end)..r.end]
+                        .iter()
+                        .filter(|q| (**q - *p).length() < support)
+                        .count();
+                });
+            }
+            let mut brute = 0usize;
+            for i in 0..sorted.len() {
+                for j in i + 1..sorted.len() {
+                    if (sorted[j] - sorted[i]).length() < support {
+                        brute += 1;
+                    }
+                }
+            }
+            assert_eq!(pairs, brute);
         }
     }
 }

@@ -5,10 +5,10 @@
 //! with `x_ij = x_i − x_j`, `v_ij = v_i − v_j`, `F = (1/r) dW/dr` (so `∇_i W_ij = x_ij F`):
 //!
 //! * pressure (symmetric form, thesis eq. 2.23): `a_i −= m (p_i/ρ_i² + p_j/ρ_j²) x_ij F`;
-//! * Monaghan artificial viscosity (eq. 2.24–2.25, β = 0, `c̄ = c₀`): `a_i −= m Π_ij x_ij F`,
-//!   `Π_ij = −α c₀ μ_ij / ρ̄_ij`, `μ_ij = h v_ij·x_ij / (r² + 0.01h²)` when `v_ij·x_ij < 0`;
-//! * Morris et al. (1997) laminar viscosity (eq. 2.26, μ = ρν):
-//!   `a_i += m ν (ρ_i + ρ_j)/(ρ_i ρ_j) · r² F/(r² + 0.01h²) · v_ij`;
+//! * Monaghan artificial viscosity (eq. 2.24–2.25, β = 0, `c̄ = c₀`, `1/ρ̄_ij = ½(1/ρ_i + 1/ρ_j)`):
+//!   `a_i −= m Π_ij x_ij F`, `Π_ij = −α c₀ μ_ij / ρ̄_ij`, `μ_ij = h min(v_ij·x_ij, 0) / (r² + 0.01h²)`;
+//! * Morris et al. (1997) laminar viscosity (eq. 2.26, μ = ρν; `(μ_i + μ_j)/(ρ_i ρ_j) = ν (1/ρ_i + 1/ρ_j)`):
+//!   `a_i += m ν (1/ρ_i + 1/ρ_j) · r² F/(r² + 0.01h²) · v_ij`;
 //! * continuity (eq. 2.21): `Dρ_i += m v_ij·x_ij F`;
 //! * δ-SPH density diffusion (Molteni & Colagrossi 2009, Comput. Phys. Commun. 180:861) with the
 //!   hydrostatic correction of Fourtakas et al. (2019, Comput. Fluids 190:346), linearised:
@@ -93,6 +93,8 @@ pub(crate) struct FluidSet<'a> {
     pub rho: &'a [f64],
     /// p/ρ² \[Pa m⁶/kg²\].
     pub pr: &'a [f64],
+    /// 1/ρ \[m³/kg\].
+    pub irho: &'a [f64],
     pub press: &'a [f64],
     /// Akinci surface normals (empty without surface tension).
     pub nrm: &'a [Vec3],
@@ -110,6 +112,7 @@ pub(crate) struct WallSet<'a> {
     pub vvisc: &'a [Vec3],
     pub rho: &'a [f64],
     pub pr: &'a [f64],
+    pub irho: &'a [f64],
     pub vol: &'a [f64],
     pub part: &'a [u16],
     pub grid: &'a NeighbourGrid,
@@ -123,9 +126,9 @@ pub(crate) struct Consts {
     pub h: f64,
     pub support: f64,
     pub r2max: f64,
-    pub c0: f64,
     pub rho0: f64,
-    pub alpha: f64,
+    /// ½ α c₀: Π_ij = −α c₀ μ_ij / ρ̄_ij with 1/ρ̄_ij = ½ (1/ρ_i + 1/ρ_j).
+    pub av: f64,
     pub eta2: f64,
     pub nu: f64,
     /// 2 δ h c₀ (0 without density diffusion).
@@ -158,13 +161,18 @@ impl Consts {
     }
 }
 
-/// Per-particle results of the fluid pass and pass-wide maxima.
+/// Per-particle results of the fluid pass, and scratch it needs.
 pub(crate) struct FluidOut<'a> {
     pub acc: &'a mut [Vec3],
     pub drho: &'a mut [f64],
     pub near: &'a mut [u32],
     /// Empty when shifting is off.
     pub shift: &'a mut [Vec3],
+    /// Liquid fraction Σ V_j W_ij (scratch; length n with drag, else empty).
+    pub phi: &'a mut [f64],
+    /// Σ V_j ∇W_ij and −Σ V_j x_ij·∇W_ij (scratch; length n with shifting, else empty).
+    pub gradc: &'a mut [Vec3],
+    pub divr: &'a mut [f64],
 }
 
 /// Pass-wide statistics.
@@ -218,6 +226,7 @@ pub(crate) fn wall_state(
     gh: FluidSet,
     rho_b: &mut [f64],
     pr_b: &mut [f64],
+    irho_b: &mut [f64],
     vvisc: &mut [Vec3],
     wet: &mut [bool],
 ) {
@@ -225,10 +234,11 @@ pub(crate) fn wall_state(
         rho_b
             .par_chunks_mut(CHUNK)
             .zip(pr_b.par_chunks_mut(CHUNK))
+            .zip(irho_b.par_chunks_mut(CHUNK))
             .zip(vvisc.par_chunks_mut(CHUNK))
             .zip(wet.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(ci, (((rho_c, pr_c), vv_c), wet_c))| {
+            .for_each(|(ci, ((((rho_c, pr_c), ir_c), vv_c), wet_c))| {
                 for o in 0..rho_c.len() {
                     let b = ci * CHUNK + o;
                     let xb = wl.pos[b];
@@ -261,6 +271,7 @@ pub(crate) fn wall_state(
                     let rho = c.rho0 * (p / c.eos_b + 1.0).powf(1.0 / c.eos_gamma);
                     rho_c[o] = rho;
                     pr_c[o] = p / (rho * rho);
+                    ir_c[o] = 1.0 / rho;
                     vv_c[o] = vv;
                     wet_c[o] = is_wet;
                 }
@@ -280,24 +291,22 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     dx: Vec3,
     r2: f64,
     vi: Vec3,
-    rhoi: f64,
+    irhoi: f64,
     pri: f64,
 ) -> (Vec3, f64) {
     let r = r2.sqrt();
     let f = kf.f(r);
-    let rhob = wl.rho[b];
-    let mb = rhob * wl.vol[b];
+    let irhob = wl.irho[b];
+    let mb = wl.rho[b] * wl.vol[b];
+    let inv_d = 1.0 / (r2 + c.eta2);
     let vr = (vi - wl.vel[b]).dot(dx);
-    let mut s = -(pri + wl.pr[b]);
-    if vr < 0.0 {
-        let mu = c.h * vr / (r2 + c.eta2);
-        s += 2.0 * c.alpha * c.c0 * mu / (rhoi + rhob);
-    }
+    let mu = c.h * vr.min(0.0) * inv_d;
+    let s = -(pri + wl.pr[b]) + c.av * mu * (irhoi + irhob);
     let mut acc = dx * (mb * s * f);
     let d = mb * vr * f;
     if EXTRA {
         if c.nu > 0.0 {
-            acc += (vi - wl.vvisc[b]) * (mb * c.nu * (rhoi + rhob) / (rhoi * rhob) * r2 * f / (r2 + c.eta2));
+            acc += (vi - wl.vvisc[b]) * (mb * c.nu * (irhoi + irhob) * r2 * f * inv_d);
         }
         if c.gamma_st > 0.0 && r > 0.0 {
             let beta = c.beta[wl.part[b] as usize];
@@ -309,8 +318,46 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     (acc, d)
 }
 
+/// Accumulators of a contiguous range of fluid particles.
+struct Acc<'a> {
+    acc: &'a mut [Vec3],
+    drho: &'a mut [f64],
+    phi: &'a mut [f64],
+    gradc: &'a mut [Vec3],
+    divr: &'a mut [f64],
+}
+
+fn split<T>(v: &mut [T], mid: usize) -> (&mut [T], &mut [T]) {
+    if v.is_empty() {
+        (&mut [], &mut [])
+    } else {
+        v.split_at_mut(mid)
+    }
+}
+
+impl<'a> Acc<'a> {
+    fn split_at(self, mid: usize) -> (Acc<'a>, Acc<'a>) {
+        let (a0, a1) = self.acc.split_at_mut(mid);
+        let (d0, d1) = self.drho.split_at_mut(mid);
+        let (p0, p1) = split(self.phi, mid);
+        let (g0, g1) = split(self.gradc, mid);
+        let (v0, v1) = split(self.divr, mid);
+        (
+            Acc { acc: a0, drho: d0, phi: p0, gradc: g0, divr: v0 },
+            Acc { acc: a1, drho: d1, phi: p1, gradc: g1, divr: v1 },
+        )
+    }
+}
+
 /// The fluid pass: acceleration, density rate, wall-proximity mask and shifting displacement of every
 /// real fluid particle.
+///
+/// Fluid–fluid pairs are evaluated once and applied to both particles (Newton's third law). To do that
+/// in parallel without locks and with a summation order independent of the thread count, the sorted
+/// particles are cut into blocks of two cell layers (cells are half a support, so a pair spans at most
+/// two layers upwards): block k only writes to blocks k and k+1, so all even blocks run in parallel, then
+/// all odd blocks. Periodic images and walls are then gathered per particle, and gravity, drag and
+/// shifting added.
 pub(crate) fn fluid_pass(
     kernel: &Kernel,
     c: &Consts,
@@ -328,6 +375,47 @@ pub(crate) fn fluid_pass(
     })
 }
 
+/// Terms of one fluid pair: acceleration of i (j gets the opposite) and the density rates of i and j.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pair_terms<K: KernelFn, const EXTRA: bool>(
+    kf: &K,
+    c: &Consts,
+    dx: Vec3,
+    r2: f64,
+    vij: Vec3,
+    (rhoi, irhoi, pri): (f64, f64, f64),
+    (rhoj, irhoj, prj): (f64, f64, f64),
+    nij: Vec3,
+) -> (Vec3, f64, f64, f64) {
+    let r = r2.sqrt();
+    let f = kf.f(r);
+    let inv_d = 1.0 / (r2 + c.eta2);
+    let vr = vij.dot(dx);
+    let mu = c.h * vr.min(0.0) * inv_d;
+    let s = -(pri + prj) + c.av * mu * (irhoi + irhoj);
+    let mut a = dx * (c.m * s * f);
+    let cont = c.m * vr * f;
+    let (mut di, mut dj) = (cont, cont);
+    if c.dc > 0.0 {
+        let psi = c.dc * (rhoi - rhoj - c.gk.dot(dx)) * f * c.m;
+        di += psi * irhoj;
+        dj -= psi * irhoi;
+    }
+    if EXTRA {
+        if c.nu > 0.0 {
+            a += vij * (c.m * c.nu * (irhoi + irhoj) * r2 * f * inv_d);
+        }
+        if c.gamma_st > 0.0 && r > 0.0 {
+            let kij = 2.0 * c.rho0 / (rhoi + rhoj);
+            let coh = akinci_cohesion(r, c.support);
+            a -= dx * (c.gamma_st * kij * c.m * coh / r);
+            a -= nij * (c.gamma_st * kij * c.curv);
+        }
+    }
+    (a, di, dj, f)
+}
+
 fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
     kf: &K,
     c: &Consts,
@@ -336,7 +424,29 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
     wl: WallSet,
     out: FluidOut,
 ) -> PassStats {
-    let FluidOut { acc, drho, near, shift } = out;
+    let FluidOut { acc, drho, near, shift, phi, gradc, divr } = out;
+    acc.par_iter_mut().for_each(|a| *a = Vec3::ZERO);
+    drho.par_iter_mut().for_each(|d| *d = 0.0);
+    phi.par_iter_mut().for_each(|d| *d = 0.0);
+    gradc.par_iter_mut().for_each(|d| *d = Vec3::ZERO);
+    divr.par_iter_mut().for_each(|d| *d = 0.0);
+    // Pairs, even blocks then odd blocks.
+    let layers = fl.grid.layers();
+    let nblocks = layers.div_ceil(2);
+    let mut pairs = 0u64;
+    for parity in 0..2usize {
+        if nblocks <= parity {
+            break;
+        }
+        let first = fl.grid.layer_start(2 * parity);
+        let accs =
+            Acc { acc: &mut *acc, drho: &mut *drho, phi: &mut *phi, gradc: &mut *gradc, divr: &mut *divr };
+        let (_, tail) = accs.split_at(first);
+        let count = (nblocks - parity).div_ceil(2);
+        pairs += tiles::<K, EXTRA>(kf, c, &fl, parity, count, tail, first);
+    }
+    let (phi, gradc, divr) = (&*phi, &*gradc, &*divr);
+    // Images, walls and body forces, per particle.
     let shifting = !shift.is_empty();
     let process = |ci: usize,
                    acc_c: &mut [Vec3],
@@ -346,7 +456,7 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
         let mut st = PassStats::default();
         for o in 0..acc_c.len() {
             let i = ci * CHUNK + o;
-            let r = fluid_particle::<K, EXTRA>(kf, c, i, &fl, &gh, &wl);
+            let r = finish_particle::<K, EXTRA>(kf, c, i, &fl, &gh, &wl, acc_c[o], d_c[o], phi, gradc, divr);
             acc_c[o] = r.acc;
             d_c[o] = r.drho;
             near_c[o] = r.near;
@@ -363,7 +473,7 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
         interactions: a.interactions + b.interactions,
     };
     let chunks = acc.par_chunks_mut(CHUNK).zip(drho.par_chunks_mut(CHUNK)).zip(near.par_chunks_mut(CHUNK));
-    if shifting {
+    let mut st = if shifting {
         chunks
             .zip(shift.par_chunks_mut(CHUNK))
             .enumerate()
@@ -374,7 +484,104 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
             .enumerate()
             .map(|(ci, ((a, d), n))| process(ci, a, d, n, None))
             .reduce(PassStats::default, merge)
+    };
+    st.interactions += 2 * pairs;
+    st
+}
+
+/// Runs the blocks `k0, k0 + 2, …` (`count` of them, one parity) in parallel; `out` covers sorted
+/// indices from `offset` on.
+#[allow(clippy::too_many_arguments)]
+fn tiles<K: KernelFn, const EXTRA: bool>(
+    kf: &K,
+    c: &Consts,
+    fl: &FluidSet,
+    k0: usize,
+    count: usize,
+    out: Acc,
+    offset: usize,
+) -> u64 {
+    let layers = fl.grid.layers();
+    if count == 1 {
+        let home = fl.grid.layer_start(2 * k0)..fl.grid.layer_start((2 * k0 + 2).min(layers));
+        let end = fl.grid.layer_start((2 * k0 + 4).min(layers));
+        let (mut mine, _) = out.split_at(end - offset);
+        return pair_block::<K, EXTRA>(kf, c, fl, home, offset, &mut mine);
     }
+    let mid = count / 2;
+    let k_mid = k0 + 2 * mid;
+    let cut = fl.grid.layer_start(2 * k_mid);
+    let (left, right) = out.split_at(cut - offset);
+    let (a, b) = rayon::join(
+        || tiles::<K, EXTRA>(kf, c, fl, k0, mid, left, offset),
+        || tiles::<K, EXTRA>(kf, c, fl, k_mid, count - mid, right, cut),
+    );
+    a + b
+}
+
+/// All pairs (i, j > i) with i in `home`, applied to both particles.
+fn pair_block<K: KernelFn, const EXTRA: bool>(
+    kf: &K,
+    c: &Consts,
+    fl: &FluidSet,
+    home: std::ops::Range<usize>,
+    offset: usize,
+    out: &mut Acc,
+) -> u64 {
+    let need_phi = EXTRA && c.drag.enabled;
+    let need_shift = EXTRA && c.shift_a > 0.0;
+    let st = EXTRA && c.gamma_st > 0.0;
+    let mut pairs = 0u64;
+    for i in home {
+        let xi = fl.pos[i];
+        let vi = fl.vel[i];
+        let si = (fl.rho[i], fl.irho[i], fl.pr[i]);
+        let ni = if st { fl.nrm[i] } else { Vec3::ZERO };
+        let vol_i = c.m * si.1;
+        let (mut ai, mut di) = (Vec3::ZERO, 0.0);
+        let (mut phi_i, mut gc_i, mut dv_i) = (0.0, Vec3::ZERO, 0.0);
+        fl.grid.for_each_run_after(xi, |run| {
+            for j in run.start.max(i + 1)..run.end {
+                let dx = xi - fl.pos[j];
+                let r2 = dx.length_squared();
+                if r2 >= c.r2max {
+                    continue;
+                }
+                pairs += 1;
+                let sj = (fl.rho[j], fl.irho[j], fl.pr[j]);
+                let nij = if st { ni - fl.nrm[j] } else { Vec3::ZERO };
+                let (a, dd_i, dd_j, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, vi - fl.vel[j], si, sj, nij);
+                let o = j - offset;
+                ai += a;
+                out.acc[o] -= a;
+                di += dd_i;
+                out.drho[o] += dd_j;
+                if need_phi {
+                    let w = kf.w(r2.sqrt());
+                    phi_i += c.m * sj.1 * w;
+                    out.phi[o] += vol_i * w;
+                }
+                if need_shift {
+                    let vol_j = c.m * sj.1;
+                    gc_i += dx * (vol_j * f);
+                    out.gradc[o] -= dx * (vol_i * f);
+                    dv_i -= vol_j * r2 * f;
+                    out.divr[o] -= vol_i * r2 * f;
+                }
+            }
+        });
+        let o = i - offset;
+        out.acc[o] += ai;
+        out.drho[o] += di;
+        if need_phi {
+            out.phi[o] += phi_i;
+        }
+        if need_shift {
+            out.gradc[o] += gc_i;
+            out.divr[o] += dv_i;
+        }
+    }
+    pairs
 }
 
 struct ParticleResult {
@@ -385,74 +592,57 @@ struct ParticleResult {
     interactions: u64,
 }
 
+/// Adds periodic-image and wall interactions, gravity, drag and shifting to the pair sums of particle i.
 #[inline(always)]
-fn fluid_particle<K: KernelFn, const EXTRA: bool>(
+#[allow(clippy::too_many_arguments)]
+fn finish_particle<K: KernelFn, const EXTRA: bool>(
     kf: &K,
     c: &Consts,
     i: usize,
     fl: &FluidSet,
     gh: &FluidSet,
     wl: &WallSet,
+    pair_acc: Vec3,
+    pair_drho: f64,
+    phi_pairs: &[f64],
+    gradc_pairs: &[Vec3],
+    divr_pairs: &[f64],
 ) -> ParticleResult {
     let xi = fl.pos[i];
     let vi = fl.vel[i];
-    let rhoi = fl.rho[i];
-    let pri = fl.pr[i];
-    let ni = if EXTRA && c.gamma_st > 0.0 { fl.nrm[i] } else { Vec3::ZERO };
-    let mut acc = Vec3::ZERO;
-    let mut d = 0.0;
-    let mut n_int = 0u64;
-    let mut phi = 0.0;
-    let mut gradc = Vec3::ZERO;
-    let mut divr = 0.0;
+    let si = (fl.rho[i], fl.irho[i], fl.pr[i]);
+    let st = EXTRA && c.gamma_st > 0.0;
+    let ni = if st { fl.nrm[i] } else { Vec3::ZERO };
     let need_phi = EXTRA && c.drag.enabled;
     let need_shift = EXTRA && c.shift_a > 0.0;
-    for (ghost, set) in [(false, fl), (true, gh)] {
-        set.grid.for_each_run(xi, |run| {
-            for j in run {
-                let dx = xi - set.pos[j];
-                let r2 = dx.length_squared();
-                if r2 >= c.r2max || (!ghost && j == i) {
-                    continue;
-                }
-                n_int += 1;
-                let r = r2.sqrt();
-                let f = kf.f(r);
-                let vij = vi - set.vel[j];
-                let vr = vij.dot(dx);
-                let rhoj = set.rho[j];
-                let mut s = -(pri + set.pr[j]);
-                if vr < 0.0 {
-                    let mu = c.h * vr / (r2 + c.eta2);
-                    s += 2.0 * c.alpha * c.c0 * mu / (rhoi + rhoj);
-                }
-                acc += dx * (c.m * s * f);
-                d += c.m * vr * f;
-                let vj = c.m / rhoj;
-                if c.dc > 0.0 {
-                    d += c.dc * (rhoi - rhoj - c.gk.dot(dx)) * f * vj;
-                }
-                if EXTRA {
-                    if c.nu > 0.0 {
-                        acc += vij * (c.m * c.nu * (rhoi + rhoj) / (rhoi * rhoj) * r2 * f / (r2 + c.eta2));
-                    }
-                    if need_phi {
-                        phi += vj * kf.w(r);
-                    }
-                    if need_shift {
-                        gradc += dx * (vj * f);
-                        divr -= vj * r2 * f;
-                    }
-                    if c.gamma_st > 0.0 && r > 0.0 {
-                        let kij = 2.0 * c.rho0 / (rhoi + rhoj);
-                        let coh = akinci_cohesion(r, c.support);
-                        acc -= dx * (c.gamma_st * kij * c.m * coh / r);
-                        acc -= (ni - set.nrm[j]) * (c.gamma_st * kij * c.curv);
-                    }
-                }
+    let mut acc = pair_acc;
+    let mut d = pair_drho;
+    let mut n_int = 0u64;
+    let mut phi = if need_phi { phi_pairs[i] } else { 0.0 };
+    let mut gradc = if need_shift { gradc_pairs[i] } else { Vec3::ZERO };
+    let mut divr = if need_shift { divr_pairs[i] } else { 0.0 };
+    gh.grid.for_each_run(xi, |run| {
+        for j in run {
+            let dx = xi - gh.pos[j];
+            let r2 = dx.length_squared();
+            if r2 >= c.r2max {
+                continue;
             }
-        });
-    }
+            n_int += 1;
+            let sj = (gh.rho[j], gh.irho[j], gh.pr[j]);
+            let nij = if st { ni - gh.nrm[j] } else { Vec3::ZERO };
+            let (a, dd, _, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, vi - gh.vel[j], si, sj, nij);
+            acc += a;
+            d += dd;
+            if need_phi {
+                phi += c.m * sj.1 * kf.w(r2.sqrt());
+            }
+            if need_shift {
+                gradc += dx * (c.m * sj.1 * f);
+                divr -= c.m * sj.1 * r2 * f;
+            }
+        }
+    });
     let mut near = 0u32;
     wl.grid.for_each_run(xi, |run| {
         for b in run {
@@ -462,7 +652,7 @@ fn fluid_particle<K: KernelFn, const EXTRA: bool>(
                 continue;
             }
             n_int += 1;
-            let (a, dd) = wall_pair::<K, EXTRA>(kf, c, wl, b, dx, r2, vi, rhoi, pri);
+            let (a, dd) = wall_pair::<K, EXTRA>(kf, c, wl, b, dx, r2, vi, si.1, si.2);
             acc += a;
             d += dd;
             let part = wl.part[b] as u32;
@@ -482,7 +672,7 @@ fn fluid_particle<K: KernelFn, const EXTRA: bool>(
     });
     acc += c.g;
     if need_phi {
-        acc += drag_acceleration(c, vi, rhoi, phi + c.m / rhoi * c.w0);
+        acc += drag_acceleration(c, vi, si.0, phi + c.m * si.1 * c.w0);
     }
     let mut shift = Vec3::ZERO;
     if need_shift {
@@ -533,11 +723,27 @@ pub(crate) fn wall_loads(
                             if r2 < c.r2max {
                                 let (a, _) = if extra {
                                     wall_pair::<_, true>(
-                                        &kf, c, &wl, b, dx, r2, set.vel[j], set.rho[j], set.pr[j],
+                                        &kf,
+                                        c,
+                                        &wl,
+                                        b,
+                                        dx,
+                                        r2,
+                                        set.vel[j],
+                                        set.irho[j],
+                                        set.pr[j],
                                     )
                                 } else {
                                     wall_pair::<_, false>(
-                                        &kf, c, &wl, b, dx, r2, set.vel[j], set.rho[j], set.pr[j],
+                                        &kf,
+                                        c,
+                                        &wl,
+                                        b,
+                                        dx,
+                                        r2,
+                                        set.vel[j],
+                                        set.irho[j],
+                                        set.pr[j],
                                     )
                                 };
                                 f -= a * c.m;

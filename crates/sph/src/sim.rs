@@ -77,6 +77,18 @@ pub struct PartLoad {
     pub torque: Vec3,
 }
 
+/// Wall-clock seconds spent in the phases of [`Simulation::step`] since the simulation was created or
+/// loaded (not checkpointed).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    pub predict: f64,
+    pub walls_guard: f64,
+    pub sort: f64,
+    pub wall_state: f64,
+    pub forces: f64,
+    pub correct: f64,
+}
+
 /// Scratch buffers rebuilt from the state; never part of a checkpoint.
 #[derive(Clone, Debug, Default)]
 struct Work {
@@ -86,9 +98,13 @@ struct Work {
     pos_old: Vec<Vec3>,
     press: Vec<f64>,
     pr: Vec<f64>,
+    irho: Vec<f64>,
     nrm: Vec<Vec3>,
     acc_new: Vec<Vec3>,
     drho_new: Vec<f64>,
+    phi: Vec<f64>,
+    gradc: Vec<Vec3>,
+    divr: Vec<f64>,
     keep: Vec<bool>,
     frames_old: Vec<Frame>,
     // Periodic images of fluid particles.
@@ -97,6 +113,7 @@ struct Work {
     g_vel: Vec<Vec3>,
     g_rho: Vec<f64>,
     g_pr: Vec<f64>,
+    g_irho: Vec<f64>,
     g_press: Vec<f64>,
     g_nrm: Vec<Vec3>,
     g_grid: NeighbourGrid,
@@ -111,6 +128,7 @@ struct Work {
     w_vvisc: Vec<Vec3>,
     w_rho: Vec<f64>,
     w_pr: Vec<f64>,
+    w_irho: Vec<f64>,
     w_vol: Vec<f64>,
     w_part: Vec<u16>,
     w_wet: Vec<bool>,
@@ -120,6 +138,7 @@ struct Work {
     w_tmp_b: Vec<bool>,
     w_tmp_v: Vec<Vec3>,
     ready: bool,
+    times: PhaseTimes,
 }
 
 /// A weakly compressible SPH simulation.
@@ -394,9 +413,8 @@ impl Simulation {
             h: k.h,
             support,
             r2max: support * support,
-            c0: p.sound_speed,
             rho0: p.rest_density,
-            alpha: p.artificial_viscosity,
+            av: 0.5 * p.artificial_viscosity * p.sound_speed,
             eta2: 0.01 * k.h * k.h,
             nu: p.kinematic_viscosity,
             dc: 2.0 * p.density_diffusion * k.h * p.sound_speed,
@@ -441,12 +459,17 @@ impl Simulation {
         let w = &mut self.work;
         w.press.resize(n, 0.0);
         w.pr.resize(n, 0.0);
-        w.press.par_iter_mut().zip(w.pr.par_iter_mut()).zip(self.fluid.rho.par_iter()).for_each(
-            |((p, pr), &rho)| {
+        w.irho.resize(n, 0.0);
+        w.press
+            .par_iter_mut()
+            .zip(w.pr.par_iter_mut())
+            .zip(w.irho.par_iter_mut())
+            .zip(self.fluid.rho.par_iter())
+            .for_each(|(((p, pr), ir), &rho)| {
                 *p = eos.pressure(rho);
-                *pr = *p / (rho * rho);
-            },
-        );
+                *ir = 1.0 / rho;
+                *pr = *p * *ir * *ir;
+            });
     }
 
     /// Images of fluid particles within one support of a periodic face, shifted by the period.
@@ -507,6 +530,8 @@ impl Simulation {
         w.g_rho.extend(w.g_src.iter().map(|&s| f.rho[s as usize]));
         w.g_pr.clear();
         w.g_pr.extend(w.g_src.iter().map(|&s| w.pr[s as usize]));
+        w.g_irho.clear();
+        w.g_irho.extend(w.g_src.iter().map(|&s| w.irho[s as usize]));
         w.g_press.clear();
         w.g_press.extend(w.g_src.iter().map(|&s| w.press[s as usize]));
     }
@@ -566,6 +591,7 @@ impl Simulation {
         w.w_vvisc.resize(n, Vec3::ZERO);
         w.w_rho.resize(n, 0.0);
         w.w_pr.resize(n, 0.0);
+        w.w_irho.resize(n, 0.0);
         w.w_wet.resize(n, false);
     }
 
@@ -579,6 +605,7 @@ impl Simulation {
             vel: &self.fluid.vel,
             rho: &self.fluid.rho,
             pr: &w.pr,
+            irho: &w.irho,
             press: &w.press,
             nrm: &[],
             grid: &w.grid,
@@ -588,6 +615,7 @@ impl Simulation {
             vel: &w.g_vel,
             rho: &w.g_rho,
             pr: &w.g_pr,
+            irho: &w.g_irho,
             press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
@@ -599,18 +627,40 @@ impl Simulation {
             vvisc: &[],
             rho: &[],
             pr: &[],
+            irho: &[],
             vol: &w.w_vol,
             part: &w.w_part,
             grid: &w.w_grid,
         };
-        pass::wall_state(&kernel, &c, wl, fl, gh, &mut w.w_rho, &mut w.w_pr, &mut w.w_vvisc, &mut w.w_wet);
+        pass::wall_state(
+            &kernel,
+            &c,
+            wl,
+            fl,
+            gh,
+            &mut w.w_rho,
+            &mut w.w_pr,
+            &mut w.w_irho,
+            &mut w.w_vvisc,
+            &mut w.w_wet,
+        );
+    }
+
+    /// Time spent per phase of the step so far.
+    pub fn phase_times(&self) -> PhaseTimes {
+        self.work.times
+    }
+
+    fn passes(&mut self, dt: f64) -> PassStats {
+        self.passes_timed(dt, &mut || 0.0)
     }
 
     /// Wall state, surface normals and the fluid pass; results in `work.acc_new`, `work.drho_new`.
-    fn passes(&mut self, dt: f64) -> PassStats {
+    fn passes_timed(&mut self, dt: f64, lap: &mut dyn FnMut() -> f64) -> PassStats {
         let kernel = self.kernel();
         let c = self.consts(dt);
         self.wall_state_only();
+        self.work.times.wall_state += lap();
         let n = self.fluid.len();
         let w = &mut self.work;
         let st_on = c.gamma_st > 0.0;
@@ -621,6 +671,7 @@ impl Simulation {
                 vel: &self.fluid.vel,
                 rho: &self.fluid.rho,
                 pr: &w.pr,
+                irho: &w.irho,
                 press: &w.press,
                 nrm: &[],
                 grid: &w.grid,
@@ -630,6 +681,7 @@ impl Simulation {
                 vel: &w.g_vel,
                 rho: &w.g_rho,
                 pr: &w.g_pr,
+                irho: &w.g_irho,
                 press: &w.g_press,
                 nrm: &[],
                 grid: &w.g_grid,
@@ -640,12 +692,17 @@ impl Simulation {
         }
         w.acc_new.resize(n, Vec3::ZERO);
         w.drho_new.resize(n, 0.0);
+        w.phi.resize(if c.drag.enabled { n } else { 0 }, 0.0);
+        let ns = if c.shift_a > 0.0 { n } else { 0 };
+        w.gradc.resize(ns, Vec3::ZERO);
+        w.divr.resize(ns, 0.0);
         let (nrm, g_nrm): (&[Vec3], &[Vec3]) = if st_on { (&w.nrm, &w.g_nrm) } else { (&[], &[]) };
         let fl = FluidSet {
             pos: &self.fluid.pos,
             vel: &self.fluid.vel,
             rho: &self.fluid.rho,
             pr: &w.pr,
+            irho: &w.irho,
             press: &w.press,
             nrm,
             grid: &w.grid,
@@ -655,6 +712,7 @@ impl Simulation {
             vel: &w.g_vel,
             rho: &w.g_rho,
             pr: &w.g_pr,
+            irho: &w.g_irho,
             press: &w.g_press,
             nrm: g_nrm,
             grid: &w.g_grid,
@@ -666,6 +724,7 @@ impl Simulation {
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
             pr: &w.w_pr,
+            irho: &w.w_irho,
             vol: &w.w_vol,
             part: &w.w_part,
             grid: &w.w_grid,
@@ -675,8 +734,13 @@ impl Simulation {
             drho: &mut w.drho_new,
             near: &mut self.fluid.near,
             shift: &mut self.fluid.shift,
+            phi: &mut w.phi,
+            gradc: &mut w.gradc,
+            divr: &mut w.divr,
         };
-        pass::fluid_pass(&kernel, &c, fl, gh, wl, out)
+        let st = pass::fluid_pass(&kernel, &c, fl, gh, wl, out);
+        w.times.forces += lap();
+        st
     }
 
     fn update_dt(&mut self, st: PassStats) {
@@ -714,6 +778,16 @@ impl Simulation {
         }
         let dt = self.dt;
         let t1 = self.time + dt;
+        let clock = std::time::Instant::now();
+        let mut lap = {
+            let mut last = clock;
+            move || {
+                let now = std::time::Instant::now();
+                let d = (now - last).as_secs_f64();
+                last = now;
+                d
+            }
+        };
         // Predictor and drift.
         self.work.pos_old.clear();
         self.work.pos_old.extend_from_slice(&self.fluid.pos);
@@ -736,6 +810,7 @@ impl Simulation {
                     *rho += d * dt;
                 });
         }
+        self.work.times.predict += lap();
         // Walls move to the new time; the guard stops crossings.
         self.work.frames_old.clear();
         self.work.frames_old.extend_from_slice(&self.boundary.frames);
@@ -743,9 +818,11 @@ impl Simulation {
         self.last.guard_hits = self.guard();
         self.count_flux();
         self.wrap_and_remove()?;
+        self.work.times.walls_guard += lap();
         // Forces at the new positions.
         self.prepare_sets();
-        let st = self.passes(dt);
+        self.work.times.sort += lap();
+        let st = self.passes_timed(dt, &mut lap);
         self.accumulate_wetting(dt);
         // Corrector.
         {
@@ -768,6 +845,7 @@ impl Simulation {
         self.time = t1;
         self.steps += 1;
         self.update_dt(st);
+        self.work.times.correct += lap();
         Ok(())
     }
 
@@ -930,6 +1008,7 @@ impl Simulation {
             vel: &self.fluid.vel,
             rho: &self.fluid.rho,
             pr: &w.pr,
+            irho: &w.irho,
             press: &w.press,
             nrm: &[],
             grid: &w.grid,
@@ -939,6 +1018,7 @@ impl Simulation {
             vel: &w.g_vel,
             rho: &w.g_rho,
             pr: &w.g_pr,
+            irho: &w.g_irho,
             press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
@@ -950,6 +1030,7 @@ impl Simulation {
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
             pr: &w.w_pr,
+            irho: &w.w_irho,
             vol: &w.w_vol,
             part: &w.w_part,
             grid: &w.w_grid,
@@ -989,6 +1070,7 @@ impl Simulation {
             vel: &self.fluid.vel,
             rho: &self.fluid.rho,
             pr: &w.pr,
+            irho: &w.irho,
             press: &w.press,
             nrm: &[],
             grid: &w.grid,
@@ -998,6 +1080,7 @@ impl Simulation {
             vel: &w.g_vel,
             rho: &w.g_rho,
             pr: &w.g_pr,
+            irho: &w.g_irho,
             press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
