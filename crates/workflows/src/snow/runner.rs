@@ -416,12 +416,14 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
         &axes.d_label(),
     );
     s.headline.push(format!("{:<20} {:>8} {:>8}", "case", "sticks", "thesis"));
+    let mut lines: Vec<(String, Vec<(f64, f64)>, (u8, u8, u8))> = Vec::new();
     for (c, case) in cases.iter().enumerate() {
         let recs = sets[c].1;
         let count = regime::stick_count(recs);
         let iface = regime::interface(recs, n_d, n_v, 0);
         let pts: Vec<(f64, f64)> = iface.points.iter().map(|q| (axes.v(q[1]), axes.d(q[0]))).collect();
-        chart = chart.line_colored(&format!("{} ({count})", case.name), &pts, output::case_colour(c));
+        // The baseline is drawn last so that cases on top of it do not hide it.
+        lines.push((format!("{} ({count})", case.name), pts, output::case_colour(c)));
         let cc = case_config(cfg, case);
         let sy = match cc.contact.restitution {
             RestitutionModel::Thornton { yield_stress_pa, .. } => yield_stress_pa,
@@ -455,6 +457,12 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
                 s.artifacts.push(("baseline wall rule (regime_map.json)".into(), jpath));
             }
         }
+    }
+    if !lines.is_empty() {
+        lines.rotate_left(1);
+    }
+    for (label, pts, rgb) in &lines {
+        chart = chart.line_colored(label, pts, *rgb);
     }
     let tpath = ctx.dir.path("sensitivity.csv");
     spatter_io::csv::write_table(
