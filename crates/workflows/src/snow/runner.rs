@@ -386,6 +386,9 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     Ok(s)
 }
 
+/// A labelled boundary of the sensitivity picture: label, points, colour.
+type BoundaryLine = (String, Vec<(f64, f64)>, (u8, u8, u8));
+
 fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
     let cases = &cfg.sensitivity.cases;
     let base_jobs = grid_jobs(&cfg.grid);
@@ -416,7 +419,7 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
         &axes.d_label(),
     );
     s.headline.push(format!("{:<20} {:>8} {:>8}", "case", "sticks", "thesis"));
-    let mut lines: Vec<(String, Vec<(f64, f64)>, (u8, u8, u8))> = Vec::new();
+    let mut lines: Vec<BoundaryLine> = Vec::new();
     for (c, case) in cases.iter().enumerate() {
         let recs = sets[c].1;
         let count = regime::stick_count(recs);
