@@ -2,18 +2,26 @@
 
 use spatter_core::validation::Case;
 
-/// Scenario that `spatter demo` runs: (name shown to the user, TOML text).
-pub const DEMO_SCENARIO: (&str, &str) = ("(none)", "");
+/// Scenario that `spatter demo` runs: the snow regime map of `examples/snow_regime_map.toml` (the same
+/// text, built into the binary so the demo needs no files).
+pub const DEMO_SCENARIO: (&str, &str) =
+    ("examples/snow_regime_map.toml", include_str!("../../../examples/snow_regime_map.toml"));
 
 /// Names accepted by `spatter bench`.
-pub const BENCHES: &[&str] = &[];
+pub const BENCHES: &[&str] = &["snow", "track"];
 
-/// Every registered validation case.
+/// Every registered validation case, engine by engine.
 pub fn validation_cases() -> Vec<Case> {
-    Vec::new()
+    let mut cases = spatter_dem::validation_cases();
+    cases.extend(spatter_workflows::snow::validation_cases());
+    cases
 }
 
 /// Runs benchmark `name` and returns the lines to print.
-pub fn run_bench(name: &str, _quick: bool) -> anyhow::Result<Vec<String>> {
-    anyhow::bail!("no benchmark named `{name}`")
+pub fn run_bench(name: &str, quick: bool) -> anyhow::Result<Vec<String>> {
+    match name {
+        "snow" => Ok(spatter_workflows::snow::bench(quick)?),
+        "track" => Ok(spatter_flow::bench::bench(quick)?),
+        _ => anyhow::bail!("no benchmark named `{name}`; expected one of: {}", BENCHES.join(", ")),
+    }
 }
