@@ -6,13 +6,17 @@ pub mod restitution_models;
 pub mod contact;
 pub mod error;
 pub mod insertion;
+pub mod output;
 pub mod par;
 pub mod particles;
+pub mod scene;
 pub mod sim;
+pub mod timestep;
 pub mod validation;
 pub mod walls;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};
+pub use scene::{run, SceneConfig};
 pub use sim::{EnergyReport, Integrator, Settings, Simulation};
 pub use validation::validation_cases;

@@ -81,7 +81,7 @@ pub use damping::{
 };
 pub use normal::{Hertz, HertzParams, Hooke, HookeParams, HookeStiffness, NormalForce, NormalLaw};
 pub use pair::{PairProps, PairTable};
-pub use rolling::{ConstantTorque, NoRolling, RollingLaw, ViscousRolling};
+pub use rolling::{AnyRolling, ConstantTorque, NoRolling, RollingLaw, ViscousRolling};
 pub use tangential::{
     Frictionless, LinearHistory, Mindlin, MindlinParams, SpringHistory, TangentialForce, TangentialLaw,
 };

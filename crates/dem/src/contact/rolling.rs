@@ -99,3 +99,32 @@ impl RollingLaw for NoRolling {
         (Vec3::ZERO, 0.0)
     }
 }
+
+/// Rolling law chosen at run time (a `match` per contact, no `dyn`): none, constant torque or viscous.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnyRolling {
+    #[default]
+    None,
+    ConstantTorque,
+    Viscous,
+}
+
+impl RollingLaw for AnyRolling {
+    /// (μ_r, μ_rv).
+    type Params = (f64, f64);
+    type State = ();
+
+    fn params(&self, _pair_index: usize, props: &PairProps) -> (f64, f64) {
+        (props.rolling_friction, props.rolling_viscous)
+    }
+
+    #[inline]
+    fn torque(&self, p: &(f64, f64), s: &mut (), f_n: f64, c: &ContactInput) -> (Vec3, f64) {
+        match self {
+            AnyRolling::None => (Vec3::ZERO, 0.0),
+            AnyRolling::ConstantTorque => ConstantTorque.torque(&p.0, s, f_n, c),
+            AnyRolling::Viscous => ViscousRolling.torque(&p.1, s, f_n, c),
+        }
+    }
+}

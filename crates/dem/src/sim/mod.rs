@@ -160,6 +160,15 @@ impl<S> Default for DynState<S> {
     }
 }
 
+/// Everything that evolves during a run; see [`Simulation::state`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SimState<S> {
+    pub particles: Particles,
+    pub dynamic: DynState<S>,
+    /// Impact records of each wall (`None` for analytic walls).
+    pub mesh_records: Vec<Option<crate::walls::MeshRecords>>,
+}
+
 /// Read-only view of the particle arrays for the external-force hook.
 #[derive(Clone, Copy, Debug)]
 pub struct ParticleView<'a> {
@@ -288,13 +297,63 @@ impl<L: ContactLaw> Simulation<L> {
         &self.st.energy
     }
 
-    /// Adds a particle (material `p.material` must exist); returns its id.
+    /// Adds a particle (material `p.material` must exist); returns its id. The particle starts with the
+    /// force of gravity (and no contact force: insert particles without overlaps), so adding particles
+    /// during a run needs no extra force evaluation.
     pub fn add_particle(&mut self, p: NewParticle) -> u32 {
         let rho = self.materials[p.material as usize].density;
         self.st.r_max = self.st.r_max.max(p.radius);
         self.st.needs_rebuild = true;
-        self.st.forces_valid = false;
-        self.particles.push(p, rho)
+        let id = self.particles.push(p, rho);
+        let i = self.particles.len() - 1;
+        if !p.frozen {
+            self.particles.force[i] = self.particles.mass[i] * self.gravity;
+        }
+        id
+    }
+
+    /// A snapshot of everything that evolves (particles, contact states, lists, energy accounts, mesh
+    /// records), for checkpoints. Restoring it into a simulation built from the same inputs continues the
+    /// run bit for bit.
+    pub fn state(&self) -> SimState<L::State> {
+        SimState {
+            particles: self.particles.clone(),
+            dynamic: self.st.clone(),
+            mesh_records: self
+                .walls
+                .iter()
+                .map(|w| match &w.shape {
+                    WallShape::Mesh(m) => Some(m.records.clone()),
+                    _ => None,
+                })
+                .collect(),
+        }
+    }
+
+    /// Restores a snapshot taken by [`Simulation::state`] of a simulation with the same materials and walls.
+    pub fn restore(&mut self, s: SimState<L::State>) -> Result<(), String> {
+        if s.mesh_records.len() != self.walls.len() {
+            return Err(format!(
+                "checkpoint has {} walls, the scene {}",
+                s.mesh_records.len(),
+                self.walls.len()
+            ));
+        }
+        for (w, rec) in self.walls.iter_mut().zip(s.mesh_records) {
+            match (&mut w.shape, rec) {
+                (WallShape::Mesh(m), Some(r)) if r.impacts.len() == m.mesh.triangles.len() => m.records = r,
+                (WallShape::Mesh(_), _) | (_, Some(_)) => {
+                    return Err(format!("wall `{}` does not match the checkpoint", w.name));
+                }
+                _ => {}
+            }
+        }
+        self.particles = s.particles;
+        self.st = s.dynamic;
+        let n = self.st.wall_list.state.len();
+        self.st.wall_list.out.clear();
+        self.st.wall_list.out.resize(n, forces::SlotOut::default());
+        Ok(())
     }
 
     /// Adds a wall; returns its index.

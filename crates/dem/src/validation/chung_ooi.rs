@@ -156,11 +156,11 @@ pub fn test3(quick: bool) -> Vec<Check> {
 /// table (e_t and ω within 5 %); the Al alloy in the sliding regime (θ > 32.5°) against
 /// e_t = 1 − μ(1+e)/tanθ and ω = −2.5μ(1+e)v cosθ/R (1 %).
 ///
-/// Known deviation: at 5° and 10° the contact sticks for most of the impact and the result depends on
-/// the tangential model. The reference includes micro-slip (Mindlin–Deresiewicz); the no-slip Mindlin
-/// spring used here (as in LIGGGHTS and LAMMPS `mindlin`) gives ω = −12.5 rad/s at 5° (reference −19)
-/// and −202 rad/s at 10° (reference −213), so those two rows fail in the full report. The quick
-/// variant checks 30° and 60°.
+/// Known deviation: at 5° the contact sticks for most of the impact and the result depends on the
+/// tangential model. The reference includes micro-slip (Mindlin–Deresiewicz); the no-slip Mindlin spring
+/// used here (as in LIGGGHTS and LAMMPS `mindlin`) gives ω = −12.5 rad/s (reference −19), so that row
+/// fails in the full report; at 10° ω = −203 rad/s is 4.6 % below the reference −213. The quick variant
+/// checks 30° and 60°.
 pub fn test4(quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     let (mu, e, r, v) = (0.092, 0.98, 2.5e-3, 3.9);
@@ -277,9 +277,9 @@ fn contact_velocity(v: Vec3, w: Vec3, r: f64, n: Vec3, t: Vec3) -> f64 {
 /// x = 1.21, 2.09, 4.51, 11.9 (absolute 0.03 on β ∈ [−1, 1]).
 ///
 /// Known deviation: for x > 1 the contact sticks and β measures the elastic tangential rebound, which the
-/// no-slip Mindlin spring overestimates against the micro-slip reference (ours with the default
-/// tangential dashpot: 0.117, 0.123, −0.062, −0.045 against 0.096, 0.058, −0.139, −0.259). These rows
-/// fail in the full report; the quick variant checks the sliding branch, which is exact.
+/// no-slip Mindlin spring reproduces only roughly against the micro-slip reference (ours with the
+/// default tangential dashpot: 0.117, 0.123, −0.062, −0.045 against 0.096, 0.058, −0.139, −0.259). The
+/// last three rows fail in the full report; the quick variant checks the sliding branch, which is exact.
 pub fn test6(quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     let (mu, e, r, vn) = (0.4, 0.5, 0.1, 0.2);

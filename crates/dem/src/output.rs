@@ -1,0 +1,89 @@
+//! Output files: particle and mesh VTU snapshots, the energy CSV columns.
+
+use crate::contact::ContactLaw;
+use crate::sim::{EnergyReport, Simulation};
+use crate::walls::{WallKinematics, WallShape};
+use spatter_io::vtu::Vtu;
+use std::io;
+use std::path::Path;
+
+/// Columns of `energy.csv` (units in the names).
+pub const ENERGY_COLUMNS: &[&str] = &[
+    "t_s",
+    "step",
+    "particles",
+    "kinetic_J",
+    "rotational_J",
+    "elastic_J",
+    "potential_J",
+    "dissipated_J",
+    "external_work_J",
+    "wall_work_J",
+    "total_J",
+    "pair_contacts",
+    "wall_contacts",
+    "list_rebuilds",
+    "removed",
+];
+
+/// One row of `energy.csv`.
+pub fn energy_row<L: ContactLaw>(sim: &Simulation<L>, e: &EnergyReport) -> Vec<f64> {
+    vec![
+        e.time,
+        sim.step_count() as f64,
+        sim.particles.len() as f64,
+        e.kinetic,
+        e.rotational,
+        e.elastic,
+        e.potential,
+        e.dissipated,
+        e.external_work,
+        e.wall_work,
+        e.total(),
+        e.pair_contacts as f64,
+        e.wall_contacts as f64,
+        sim.rebuild_count() as f64,
+        sim.removed_count() as f64,
+    ]
+}
+
+/// Writes the particles as a VTU point cloud with `id`, `material`, `radius_m`, `velocity_m_s`,
+/// `angular_velocity_rad_s`, `force_N` and `frozen`.
+pub fn write_particles<L: ContactLaw>(sim: &Simulation<L>, path: &Path) -> io::Result<()> {
+    let p = &sim.particles;
+    Vtu::point_cloud(&p.pos)
+        .point_int("id", &p.id.iter().map(|&i| i as i64).collect::<Vec<_>>())
+        .point_int("material", &p.material.iter().map(|&m| m as i64).collect::<Vec<_>>())
+        .point_int("frozen", &p.inv_mass.iter().map(|&m| (m == 0.0) as i64).collect::<Vec<_>>())
+        .point_scalar("radius_m", &p.radius)
+        .point_vector("velocity_m_s", &p.vel)
+        .point_vector("angular_velocity_rad_s", &p.omega)
+        .point_vector("force_N", &p.force)
+        .write(path)
+}
+
+/// Writes mesh wall `w` at its current position with the per-triangle impact records as cell data:
+/// `normal_impulse_N_s`, `tangential_impulse_N_s`, `impacts`, `mean_impact_speed_m_s`. Returns false for
+/// an analytic wall (nothing written).
+pub fn write_mesh<L: ContactLaw>(sim: &Simulation<L>, w: usize, path: &Path) -> io::Result<bool> {
+    let wall = &sim.walls[w];
+    let WallShape::Mesh(m) = &wall.shape else {
+        return Ok(false);
+    };
+    let k = WallKinematics::of(&wall.motion, sim.time());
+    let verts: Vec<_> = m.mesh.vertices.iter().map(|v| k.pose.apply(*v)).collect();
+    let r = &m.records;
+    let mean: Vec<f64> = r
+        .impact_speed_sum
+        .iter()
+        .zip(&r.impacts)
+        .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
+        .collect();
+    Vtu::triangles(&verts, &m.mesh.triangles)
+        .cell_scalar("normal_impulse_N_s", &r.normal_impulse)
+        .cell_scalar("tangential_impulse_N_s", &r.tangential_impulse)
+        .cell_int("impacts", &r.impacts.iter().map(|&i| i as i64).collect::<Vec<_>>())
+        .cell_scalar("mean_impact_speed_m_s", &mean)
+        .write(path)?;
+    Ok(true)
+}

@@ -1,0 +1,12 @@
+//! Scenes: a DEM simulation described by a configuration ([`SceneConfig`], the `kind = "dem"` scenario
+//! body) and run into a run folder by [`run`], with checkpoint and bit-identical resume.
+
+mod config;
+mod run;
+pub mod setup;
+
+pub use config::*;
+pub use run::run;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,173 @@
+//! Scene tests: parsing and validation messages, an interrupted and resumed run equals an uninterrupted
+//! one bit for bit, and the shipped example is valid.
+
+use super::*;
+use spatter_core::check::Checker;
+use spatter_core::control::{Finished, StopAfterPolls, Unattended};
+use spatter_io::run::{RunContext, RunDir};
+use std::path::Path;
+
+/// A small pour: a box of planes, an STL floor, a lattice fill and an injector, with rolling resistance.
+fn pour_toml(stl: &Path) -> String {
+    format!(
+        r#"
+dt_s = 5e-5
+duration_s = 0.04
+output_interval_s = 0.01
+seed = 7
+
+[contact]
+rolling = "constant_torque"
+
+[materials.grain]
+youngs_modulus_pa = 5e7
+poisson_ratio = 0.3
+density_kg_m3 = 2500
+
+[materials.steel]
+youngs_modulus_pa = 2e11
+poisson_ratio = 0.3
+density_kg_m3 = 7800
+
+[pair_defaults]
+friction = 0.5
+restitution = 0.4
+rolling_friction = 0.02
+
+[[pairs]]
+materials = ["grain", "steel"]
+friction = 0.3
+
+[[walls]]
+name = "floor"
+material = "steel"
+shape = {{ type = "mesh", file = "{}" }}
+
+[[walls]]
+name = "xlo"
+material = "steel"
+shape = {{ type = "plane", point_m = [0, 0, 0], normal = [1, 0, 0] }}
+
+[[walls]]
+name = "xhi"
+material = "steel"
+shape = {{ type = "plane", point_m = [0.06, 0, 0], normal = [-1, 0, 0] }}
+
+[[walls]]
+name = "ylo"
+material = "steel"
+shape = {{ type = "plane", point_m = [0, 0, 0], normal = [0, 1, 0] }}
+
+[[walls]]
+name = "yhi"
+material = "steel"
+shape = {{ type = "plane", point_m = [0, 0.06, 0], normal = [0, -1, 0] }}
+
+[[fill]]
+material = "grain"
+method = "lattice"
+region = {{ type = "box", min_m = [0, 0, 0], max_m = [0.06, 0.06, 0.03] }}
+size = {{ kind = "uniform", min = 0.005, max = 0.006 }}
+
+[[inject]]
+material = "grain"
+region = {{ type = "box", min_m = [0, 0, 0.04], max_m = [0.06, 0.06, 0.06] }}
+size = {{ kind = "mono", diameter = 0.005 }}
+particles_per_s = 2000
+velocity_m_s = [0, 0, -0.5]
+interval_s = 0.005
+"#,
+        stl.display()
+    )
+}
+
+fn floor_stl(dir: &Path) -> std::path::PathBuf {
+    let mut m = spatter_core::mesh::TriMesh::rectangle(0.08, 0.08, 0.0, 4, 4);
+    m.map_vertices(|v| v - spatter_core::Vec3::new(0.01, 0.01, 0.0));
+    let p = dir.join("floor.stl");
+    std::fs::write(&p, m.to_binary_stl()).unwrap();
+    p
+}
+
+fn parse(text: &str) -> SceneConfig {
+    toml::from_str(text).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn interrupted_and_resumed_run_equals_uninterrupted_run_bit_for_bit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+    let full = RunDir::create(&tmp.path().join("full")).unwrap();
+    let s = run(&cfg, &RunContext { dir: &full, control: &Unattended, resume: false }).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    let part = RunDir::create(&tmp.path().join("part")).unwrap();
+    // Stop after 333 polls (one per step), in the middle of an output interval and after injections.
+    let stop = StopAfterPolls::new(333);
+    let s = run(&cfg, &RunContext { dir: &part, control: &stop, resume: false }).unwrap();
+    assert_eq!(s.finished, Finished::Interrupted);
+    assert!(part.checkpoint_path().is_file());
+    let s = run(&cfg, &RunContext { dir: &part, control: &Unattended, resume: true }).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    assert!(!part.checkpoint_path().is_file(), "checkpoint removed after completion");
+    for rel in [
+        "energy.csv",
+        "particles.pvd",
+        "particles/particles_00004.vtu",
+        "walls/floor_00004.vtu",
+        "floor_wall.pvd",
+    ] {
+        let a = std::fs::read(full.root().join(rel)).unwrap();
+        let b = std::fs::read(part.root().join(rel)).unwrap();
+        assert!(a == b, "{rel} differs between the uninterrupted and the resumed run");
+    }
+    // The run did something: particles were injected and touch the STL floor.
+    let csv = std::fs::read_to_string(full.root().join("energy.csv")).unwrap();
+    let last: Vec<f64> = csv.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    let first: Vec<f64> = csv.lines().nth(1).unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    assert!(last[2] > first[2], "injection added particles: {} → {}", first[2], last[2]);
+    let mesh = spatter_io::vtu::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
+    let impacts = &mesh.cell_data["impacts"].1;
+    assert!(impacts.iter().sum::<f64>() > 0.0, "impacts recorded on the STL floor");
+}
+
+#[test]
+fn validation_names_the_bad_keys() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+    cfg.dt_s = -1.0;
+    cfg.pairs[0].materials[1] = "unobtainium".into();
+    cfg.pair_defaults.restitution = 1.5;
+    cfg.walls[0].material = "wood".into();
+    cfg.fill[0].size = spatter_core::distribution::SizeDistribution::Mono { diameter: -1.0 };
+    let errs = Checker::run(&cfg, None).unwrap_err();
+    let find =
+        |k: &str| errs.iter().find(|e| e.key == k).unwrap_or_else(|| panic!("no error for {k}: {errs:?}"));
+    assert!(find("dt_s").message.contains("positive"));
+    assert!(find("pairs[0].materials[1]").message.contains("unobtainium"));
+    assert_eq!(find("pair_defaults.restitution").message, "restitution = 1.5 is outside (0, 1]");
+    assert!(find("walls[0].material").message.contains("wood"));
+    assert!(find("fill[0].size").message.contains("diameter = -1"));
+    let bad = "dt_s = 1e-5\nduration_s = 1\n[materials.a]\nyoungs_modulus_pa = 1e9\npoisson_ratio = 0.3\ndensity_kg_m3 = 1000\nunknown_key = 3\n";
+    assert!(toml::from_str::<SceneConfig>(bad).is_err(), "unknown keys are rejected");
+}
+
+#[test]
+fn shipped_examples_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let p = entry.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if !(name.starts_with("dem_") && name.ends_with(".toml")) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).unwrap();
+        // Scenario files start with `kind = "dem"`, which the scenario loader consumes.
+        let body: String =
+            text.lines().filter(|l| !l.trim_start().starts_with("kind")).collect::<Vec<_>>().join("\n");
+        let cfg: SceneConfig = toml::from_str(&body).unwrap_or_else(|e| panic!("{name}: {e}"));
+        Checker::run(&cfg, Some(&root)).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        n += 1;
+    }
+    assert!(n >= 1, "no examples/dem_*.toml found");
+}
