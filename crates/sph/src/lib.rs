@@ -25,6 +25,7 @@ pub mod neighbours;
 pub mod params;
 mod pass;
 pub mod sim;
+pub mod validation;
 
 pub use error::SphError;
 pub use kernel::{Dim, KernelKind};

@@ -1,0 +1,425 @@
+//! Reference cases of `spatter validate` (VERIFICATION.md, SPH section). Each runs a reduced variant in
+//! seconds (`quick = true`, also run by the crate's tests) and a finer one for the report.
+
+use crate::boundary::Slip;
+use crate::kernel::Dim;
+use crate::params::SphParams;
+use crate::sim::{Simulation, WallOptions};
+use spatter_core::validation::{Case, Check};
+use spatter_core::{Aabb, Vec3};
+
+/// Every SPH validation case.
+pub fn validation_cases() -> Vec<Case> {
+    vec![
+        Case { name: "sph_hydrostatic_tank", run: hydrostatic_tank },
+        Case { name: "sph_poiseuille", run: poiseuille },
+        Case { name: "sph_conservation", run: conservation },
+        Case { name: "sph_dam_break_surge_front", run: dam_break_front },
+        Case { name: "sph_dam_break_wall_pressure", run: dam_break_pressure },
+    ]
+}
+
+/// Advances until `t_end`, calling `sample` after every step.
+fn run_until(sim: &mut Simulation, t_end: f64, mut sample: impl FnMut(&mut Simulation)) {
+    sim.initialize().expect("validation set-up is valid");
+    while sim.time < t_end {
+        sim.step().expect("validation case runs without blow-up");
+        sample(sim);
+    }
+}
+
+const OPEN_TOP: [bool; 6] = [true, true, true, true, true, false];
+
+/// Water at rest in a tank: pressure at depth within 2 % of ρgz after settling, no particle lost,
+/// kinetic energy decaying (VERIFICATION.md). 2D; the full variant is finer and 3D.
+pub fn hydrostatic_tank(quick: bool) -> Vec<Check> {
+    let case = "sph_hydrostatic_tank";
+    let (dim, dp, t_end) = if quick { (Dim::Two, 0.01, 1.0) } else { (Dim::Three, 0.01, 1.5) };
+    let (width, depth): (f64, f64) = (0.4, 0.2);
+    let g: f64 = 9.81;
+    let mut p = SphParams::water(dim, dp, 10.0 * (2.0 * g * depth).sqrt());
+    p.gravity = Vec3::new(0.0, 0.0, -g);
+    let ly = if dim == Dim::Three { 0.1 } else { 0.0 };
+    let mut sim = Simulation::new(p);
+    sim.add_tank(
+        "tank",
+        Aabb::new(Vec3::ZERO, Vec3::new(width, ly, 2.0 * depth)),
+        OPEN_TOP,
+        None,
+        None,
+        WallOptions::default(),
+    );
+    let n0 = sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(width, ly, depth)), Vec3::ZERO, true);
+    let mut ke_max: f64 = 0.0;
+    let mut ke_late = Vec::new();
+    run_until(&mut sim, t_end, |s| {
+        let ke = s.kinetic_energy();
+        ke_max = ke_max.max(ke);
+        if s.time > 0.8 * t_end {
+            ke_late.push(ke);
+        }
+    });
+    let mut checks = Vec::new();
+    let src = "hydrostatics p = ρ g z (VERIFICATION.md, SPH)";
+    for frac in [0.25, 0.5, 0.75] {
+        let z = depth * (1.0 - frac);
+        let x = Vec3::new(0.5 * width, 0.5 * ly, z);
+        let (pr, _) = sim.probe(x).unwrap_or((f64::NAN, Vec3::ZERO));
+        let want = 1000.0 * g * frac * depth;
+        checks.push(Check::relative(
+            case,
+            format!("p at depth {:.3} m [Pa]", frac * depth),
+            want,
+            pr,
+            0.02,
+            src,
+        ));
+    }
+    let lost = n0 - sim.fluid.len();
+    checks.push(Check::absolute(case, "particles lost [-]", 0.0, lost as f64, 0.0, "closed tank"));
+    let escaped = sim.fluid.pos.iter().filter(|x| x.x < 0.0 || x.x > width || x.z < 0.0).count();
+    checks.push(Check::absolute(
+        case,
+        "particles outside the tank [-]",
+        0.0,
+        escaped as f64,
+        0.0,
+        "closed tank",
+    ));
+    // Kinetic energy at the end is below a fifth of its maximum (the start-up transient decays).
+    let ke_end = ke_late.iter().copied().fold(0.0, f64::max);
+    checks.push(Check::absolute(
+        case,
+        "KE(late)/KE(max) [-]",
+        0.0,
+        ke_end / ke_max.max(1e-300),
+        0.2,
+        "decay of the start-up transient",
+    ));
+    // Total fluid force on the tank equals the weight of the water.
+    let load = sim.part_loads()[0].force.z;
+    checks.push(Check::relative(
+        case,
+        "vertical load on the tank [N]",
+        -sim.fluid_mass() * g,
+        load,
+        0.02,
+        "weight of the water",
+    ));
+    checks
+}
+
+/// Start-up of plane Poiseuille flow (Morris, Fox & Zhu 1997, J. Comput. Phys. 136:214): plates 1 mm
+/// apart, ν = 10⁻⁶ m²/s, body force 2·10⁻⁴ m/s², periodic in x. Velocity profile within 2 % of the
+/// series solution (error relative to the steady centre-line speed).
+pub fn poiseuille(quick: bool) -> Vec<Check> {
+    let case = "sph_poiseuille";
+    let l = 1e-3;
+    let nu = 1e-6;
+    let f = 2e-4;
+    let n_across = if quick { 20 } else { 40 };
+    let dp = l / n_across as f64;
+    let u_max = f * l * l / (8.0 * nu);
+    let mut p = SphParams::water(Dim::Two, dp, 10.0 * u_max);
+    p.gravity = Vec3::new(f, 0.0, 0.0);
+    p.artificial_viscosity = 0.0;
+    p.density_diffusion = 0.0;
+    p.kinematic_viscosity = nu;
+    let lx = 16.0 * dp;
+    let mut sim = Simulation::new(p);
+    let n_layers = sim.default_layers();
+    let layers = Some(n_layers);
+    let wall = WallOptions { adhesion: 0.0, slip: Slip::NoSlip };
+    let thick = n_layers as f64 * dp;
+    sim.add_block(
+        "bottom",
+        Aabb::new(Vec3::new(0.0, 0.0, -thick), Vec3::new(lx, 0.0, 0.0)),
+        layers,
+        None,
+        wall,
+    );
+    sim.add_block(
+        "top",
+        Aabb::new(Vec3::new(0.0, 0.0, l), Vec3::new(lx, 0.0, l + thick)),
+        layers,
+        None,
+        wall,
+    );
+    sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(lx, 0.0, l)), Vec3::ZERO, false);
+    sim.set_domain(Aabb::new(Vec3::new(0.0, -1.0, -2.0 * thick), Vec3::new(lx, 1.0, l + 2.0 * thick)));
+    sim.set_periodic(0);
+    let series = |z: f64, t: f64| {
+        let mut u = f / (2.0 * nu) * z * (l - z);
+        for n in 0..200 {
+            let k = (2 * n + 1) as f64;
+            u -= 4.0 * f * l * l / (nu * std::f64::consts::PI.powi(3) * k.powi(3))
+                * (std::f64::consts::PI * z * k / l).sin()
+                * (-(k * k) * std::f64::consts::PI.powi(2) * nu * t / (l * l)).exp();
+        }
+        u
+    };
+    let times: &[f64] = if quick { &[0.0225, 0.1125, 1.0] } else { &[0.0225, 0.045, 0.1125, 0.225, 1.0] };
+    let mut checks = Vec::new();
+    sim.initialize().expect("valid set-up");
+    for &t in times {
+        while sim.time < t {
+            sim.step().expect("no blow-up");
+        }
+        // Mean u_x per lattice row against the series at the row centre.
+        let mut sum = vec![0.0; n_across];
+        let mut cnt = vec![0usize; n_across];
+        for (x, v) in sim.fluid.pos.iter().zip(&sim.fluid.vel) {
+            let k = ((x.z / dp).floor().max(0.0) as usize).min(n_across - 1);
+            sum[k] += v.x;
+            cnt[k] += 1;
+        }
+        let mut worst: f64 = 0.0;
+        for k in 0..n_across {
+            if cnt[k] > 0 {
+                let z = (k as f64 + 0.5) * dp;
+                worst = worst.max((sum[k] / cnt[k] as f64 - series(z, sim.time)).abs());
+            }
+        }
+        checks.push(Check::absolute(
+            case,
+            format!("max |u − u_series|/u_max at t = {t} s [-]"),
+            0.0,
+            worst / u_max,
+            0.02,
+            "Morris, Fox & Zhu (1997) series solution",
+        ));
+    }
+    checks
+}
+
+/// Momentum and mass of a free blob (no gravity, no walls) with random velocities: total momentum
+/// conserved to round-off by the pairwise forces, particle count (mass) exact.
+pub fn conservation(quick: bool) -> Vec<Check> {
+    let case = "sph_conservation";
+    let n = if quick { 8 } else { 14 };
+    let dp = 0.01;
+    let mut p = SphParams::water(Dim::Three, dp, 20.0);
+    p.gravity = Vec3::ZERO;
+    p.density_window = [0.0, f64::INFINITY];
+    let mut sim = Simulation::new(p);
+    let mut pts = Vec::new();
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                pts.push(Vec3::new(i as f64, j as f64, k as f64) * dp);
+            }
+        }
+    }
+    sim.add_particles(&pts, Vec3::ZERO);
+    let mut rng = spatter_core::rng::seeded(7, 0);
+    use spatter_core::rng::RngExt;
+    for v in &mut sim.fluid.vel {
+        *v = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5);
+    }
+    sim.set_domain(Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0)));
+    sim.initialize().expect("valid set-up");
+    let p0 = sim.momentum();
+    let scale = sim.params.mass() * sim.fluid.vel.iter().map(|v| v.length()).sum::<f64>();
+    let steps = if quick { 40 } else { 400 };
+    for _ in 0..steps {
+        sim.step().expect("no blow-up");
+    }
+    let dpm = (sim.momentum() - p0).length() / scale;
+    vec![
+        Check::absolute(case, "|ΔP|/Σ m|v| [-]", 0.0, dpm, 1e-12, "pairwise antisymmetric forces"),
+        Check::absolute(
+            case,
+            "particles lost [-]",
+            0.0,
+            (pts.len() - sim.fluid.len()) as f64,
+            0.0,
+            "mass is exact",
+        ),
+    ]
+}
+
+/// Martin & Moyce (1952) collapse of a water column of width a and height 2a (n² = 2, a = 2.25 in),
+/// surge front Z = x/a against T = t √(2g/a), as digitised from their Fig. 3.
+const MARTIN_MOYCE: [(f64, f64); 5] =
+    [(0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.345, 4.134)];
+
+/// Surge front of the a × 2a dam break against Martin & Moyce (1952), error at each reference point (2D).
+pub fn dam_break_front(quick: bool) -> Vec<Check> {
+    let case = "sph_dam_break_surge_front";
+    let a: f64 = 0.1;
+    let g: f64 = 9.81;
+    let dp = if quick { a / 20.0 } else { a / 50.0 };
+    let mut p = SphParams::water(Dim::Two, dp, 10.0 * (2.0 * g * 2.0 * a).sqrt());
+    p.gravity = Vec3::new(0.0, 0.0, -g);
+    let mut sim = Simulation::new(p);
+    sim.add_tank(
+        "tank",
+        Aabb::new(Vec3::ZERO, Vec3::new(6.0 * a, 0.0, 3.0 * a)),
+        OPEN_TOP,
+        None,
+        None,
+        WallOptions::default(),
+    );
+    sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(a, 0.0, 2.0 * a)), Vec3::ZERO, true);
+    let tscale = (2.0 * g / a).sqrt();
+    let t_end = (MARTIN_MOYCE[MARTIN_MOYCE.len() - 1].0 + 0.05) / tscale;
+    let mut track: Vec<(f64, f64)> = Vec::new();
+    run_until(&mut sim, t_end, |s| {
+        let front = s.fluid.pos.iter().map(|x| x.x).fold(0.0, f64::max) + 0.5 * dp;
+        track.push((s.time * tscale, front / a));
+    });
+    // The measured front lags inviscid solutions while the column is released (the membrane took a finite
+    // time to clear, and floor friction slows the thin tongue): numerical models run 10–20 % ahead of the
+    // data for T < 2. Each point is reported with a 20 % tolerance; the front speed over the developed phase
+    // T ∈ [2.0, 3.35], which does not depend on the time origin, is checked at 5 %.
+    let mut checks: Vec<Check> = MARTIN_MOYCE
+        .iter()
+        .map(|&(t_ref, z_ref)| {
+            let z = interpolate(&track, t_ref);
+            Check::relative(
+                case,
+                format!("Z = x/a at T = {t_ref}"),
+                z_ref,
+                z,
+                0.20,
+                "Martin & Moyce (1952), n² = 2, Fig. 3",
+            )
+        })
+        .collect();
+    let (t0, z0) = MARTIN_MOYCE[2];
+    let (t1, z1) = MARTIN_MOYCE[4];
+    let speed_ref = (z1 - z0) / (t1 - t0);
+    let speed = (interpolate(&track, t1) - interpolate(&track, t0)) / (t1 - t0);
+    checks.push(Check::relative(
+        case,
+        "front speed dZ/dT, T ∈ [2.0, 3.35]",
+        speed_ref,
+        speed,
+        0.05,
+        "Martin & Moyce (1952), n² = 2, Fig. 3",
+    ));
+    checks
+}
+
+/// Linear interpolation in a sorted table.
+fn interpolate(table: &[(f64, f64)], x: f64) -> f64 {
+    match table.iter().position(|p| p.0 >= x) {
+        None => table.last().map(|p| p.1).unwrap_or(f64::NAN),
+        Some(0) => table[0].1,
+        Some(k) => {
+            let (a, b) = (table[k - 1], table[k]);
+            a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+        }
+    }
+}
+
+/// Wall pressure p/(ρgH) at sensor P1 against T = t √(g/H) for the Buchner (2002) dam break at spacing
+/// H/`n` (see [`dam_break_pressure`]).
+pub fn dam_break_pressure_series(n: usize) -> Vec<(f64, f64)> {
+    let h: f64 = 0.6;
+    let g: f64 = 9.81;
+    let dp = h / n as f64;
+    let mut p = SphParams::water(Dim::Two, dp, 10.0 * (2.0 * g * h).sqrt());
+    p.gravity = Vec3::new(0.0, 0.0, -g);
+    let mut sim = Simulation::new(p);
+    let lx = 5.366 * h;
+    sim.add_tank(
+        "tank",
+        Aabb::new(Vec3::ZERO, Vec3::new(lx, 0.0, 3.0 * h)),
+        OPEN_TOP,
+        None,
+        None,
+        WallOptions::default(),
+    );
+    sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(2.0 * h, 0.0, h)), Vec3::ZERO, true);
+    let tscale = (g / h).sqrt();
+    let pscale = 1000.0 * g * h;
+    // Sensor P1 as in Adami et al. (2012) and TrixiParticles.jl, following Greco (2001): the wall segment
+    // z ∈ [0.07, 0.16] m whose top is at the experimental sensor centre.
+    let sensor = Vec3::new(lx + 0.5 * dp, 0.0, 0.115);
+    let radius = 0.045_f64.max(0.75 * dp);
+    let mut series: Vec<(f64, f64)> = Vec::new();
+    let t_end = 4.7 / tscale;
+    run_until(&mut sim, t_end, |s| {
+        let pw = s.wall_pressure(sensor, radius).unwrap_or(0.0);
+        series.push((s.time * tscale, pw / pscale));
+    });
+    series
+}
+
+/// Dam break of Zhou et al. (1999) / Buchner (2002): column H = 0.6 m high and 2H wide in a tank 5.366 H
+/// long; pressure sensor P1 on the opposite wall centred 0.16 m above the floor. Reference values from
+/// Buchner's measurement (PhD thesis, TU Delft 2002) as digitised in the TrixiParticles.jl validation set
+/// (`exp_pressure_sensor_P1.csv`), in p/(ρgH) against T = t √(g/H):
+/// arrival (p first above 0.1) at T ≈ 2.48 and a quasi-steady level of 0.549 (mean over T ∈ [3.4, 4.6]).
+pub fn dam_break_pressure(quick: bool) -> Vec<Check> {
+    let case = "sph_dam_break_wall_pressure";
+    let series = dam_break_pressure_series(if quick { 20 } else { 60 });
+    let arrival = series.iter().find(|p| p.1 > 0.1).map(|p| p.0).unwrap_or(f64::NAN);
+    let plateau: Vec<f64> = series.iter().filter(|p| p.0 >= 3.4 && p.0 <= 4.6).map(|p| p.1).collect();
+    let mean = plateau.iter().sum::<f64>() / plateau.len().max(1) as f64;
+    let src = "Buchner (2002) sensor P1, digitised by TrixiParticles.jl";
+    if quick {
+        // At H/20 the run-up reaches the sensor up to 8 % late (it converges to within 5 % at H/60, see the
+        // full variant), and the quasi-steady level is not resolved; only the arrival is checked, at 10 %.
+        return vec![Check::relative(
+            case,
+            "arrival T at P1 (p > 0.1 ρgH), H/20 [-]",
+            2.48,
+            arrival,
+            0.10,
+            src,
+        )];
+    }
+    vec![
+        Check::relative(case, "arrival T at P1 (p > 0.1 ρgH) [-]", 2.48, arrival, 0.05, src),
+        Check::relative(case, "mean p/(ρgH) at P1, T ∈ [3.4, 4.6] [-]", 0.549, mean, 0.10, src),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_all_pass(checks: &[Check]) {
+        for c in checks {
+            eprintln!("{} {}: ref {} ours {} ({:?})", c.case, c.quantity, c.reference, c.ours, c.tolerance);
+        }
+        for c in checks {
+            assert!(
+                c.passed(),
+                "{} — {}: reference {}, ours {}, tolerance {:?}",
+                c.case,
+                c.quantity,
+                c.reference,
+                c.ours,
+                c.tolerance
+            );
+        }
+    }
+
+    #[test]
+    fn hydrostatic_tank_quick() {
+        assert_all_pass(&hydrostatic_tank(true));
+    }
+
+    #[test]
+    fn poiseuille_quick() {
+        assert_all_pass(&poiseuille(true));
+    }
+
+    #[test]
+    fn conservation_quick() {
+        assert_all_pass(&conservation(true));
+    }
+
+    #[test]
+    fn dam_break_front_quick() {
+        assert_all_pass(&dam_break_front(true));
+    }
+
+    #[test]
+    fn dam_break_pressure_quick() {
+        assert_all_pass(&dam_break_pressure(true));
+    }
+}
