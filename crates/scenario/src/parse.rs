@@ -99,7 +99,11 @@ fn is_value_error(m: &str) -> bool {
 /// Keeps the first line of a TOML error message and names TOML types the way users write them.
 fn tidy(m: &str) -> String {
     let first = m.lines().next().unwrap_or(m).trim();
-    first.replace("expected f64", "expected a number").replace("expected u64", "expected a whole number")
+    first
+        .replace("expected f64", "expected a number")
+        .replace("expected u64", "expected a whole number")
+        .replace("expected usize", "expected a whole number")
+        .replace("expected u32", "expected a whole number")
 }
 
 /// Dotted key path of the deepest key whose key or value contains byte `offset`.

@@ -47,7 +47,7 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
         anyhow::bail!("no validation case matches {:?}", filter.unwrap_or(""));
     }
     println!(
-        "{:<34} {:<30} {:>13} {:>13} {:>10} {:>10}  result",
+        "{:<34} {:<46} {:>13} {:>13} {:>10} {:>10}  result",
         "case", "quantity", "reference", "ours", "rel.error", "tolerance"
     );
     let (mut passed, mut failed) = (0, 0);
@@ -64,7 +64,7 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
                 failed += 1
             }
             println!(
-                "{:<34} {:<30} {:>13.6e} {:>13.6e} {:>10.2e} {:>10}  {}",
+                "{:<34} {:<46} {:>13.6e} {:>13.6e} {:>10.2e} {:>10}  {}",
                 c.case,
                 c.quantity,
                 c.reference,
