@@ -5,6 +5,7 @@
 //! * [`mesh`] — triangle meshes, STL/OBJ readers, closest point on a triangle with face/edge/vertex regions;
 //! * [`grid`] — a cell-list neighbour search shared by DEM and SPH;
 //! * [`tri_bvh`] — a triangle hierarchy: segment crossings, closest points, inside tests;
+//! * [`shapes`] — closed cylinder and box meshes;
 //! * [`surface_sample`] — boundary-particle sampling of a mesh surface at a given spacing;
 //! * [`motion`] — prescribed rigid-body kinematics (constant, rotating, tabulated, hierarchical);
 //! * [`distribution`] — particle size distributions;
@@ -28,6 +29,7 @@ pub mod mesh;
 pub mod motion;
 pub mod regime;
 pub mod rng;
+pub mod shapes;
 pub mod surface_sample;
 pub mod timestep;
 pub mod tri_bvh;
