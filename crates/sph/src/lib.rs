@@ -9,6 +9,8 @@
 //! * [`guard`] — no particle crosses a wall, however thin;
 //! * [`fill`] — fluid initialisation on a lattice (box minus solids, flood fill);
 //! * [`drag`] — air drag;
+//! * [`scene`] — the `sph` scenario kind: configuration, outputs, checkpoint/resume;
+//! * [`validation`] — reference cases for `spatter validate`;
 //! * [`sim`] — the [`Simulation`] and its time step (velocity Verlet with one force evaluation per step).
 //!
 //! See `docs/sph.md` for the equations, defaults and references.
@@ -24,6 +26,7 @@ pub mod kernel;
 pub mod neighbours;
 pub mod params;
 mod pass;
+pub mod scene;
 pub mod sim;
 pub mod validation;
 

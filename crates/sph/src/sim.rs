@@ -67,6 +67,8 @@ pub struct StepStats {
     pub dt_acoustic: f64,
     pub dt_force: f64,
     pub dt_viscous: f64,
+    /// Time step of the last step taken \[s\].
+    pub dt_taken: f64,
 }
 
 /// Fluid force and torque on one part \[N, N m; per metre of depth in 2D\].
@@ -646,6 +648,11 @@ impl Simulation {
         );
     }
 
+    /// Time step of the last step taken \[s\] (0 before the first).
+    pub fn last_dt(&self) -> f64 {
+        self.last.dt_taken
+    }
+
     /// Time spent per phase of the step so far.
     pub fn phase_times(&self) -> PhaseTimes {
         self.work.times
@@ -845,6 +852,7 @@ impl Simulation {
         self.time = t1;
         self.steps += 1;
         self.update_dt(st);
+        self.last.dt_taken = dt;
         self.work.times.correct += lap();
         Ok(())
     }
