@@ -201,11 +201,21 @@ pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
         let (_, setup) = model.setup(d, v_max, surface);
         steps.push((TimeStepReport::new(d, &cfg.particle, e_star, r_star, m, v_max), setup.dt));
     }
-    out.push(format!(
-        "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m, {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
-        tabor[0].0, tabor[0].1, ds[0], tabor[1].0, tabor[1].1, ds[1]
-    ));
+    out.push(if ds[1] == ds[0] {
+        format!(
+            "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
+            tabor[0].0, tabor[0].1, ds[0]
+        )
+    } else {
+        format!(
+            "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m, {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
+            tabor[0].0, tabor[0].1, ds[0], tabor[1].0, tabor[1].1, ds[1]
+        )
+    });
     for (i, (t, dt)) in steps.iter().enumerate() {
+        if i == 1 && ds[1] == ds[0] {
+            break;
+        }
         out.push(format!(
             "time steps at d = {:.3e} m: thesis Eq. 24 {:.4e} s, Rayleigh {:.4e} s, Hertz time at {:.3} m/s {:.4e} s; used {:.4e} s",
             ds[i], t.thesis_eq24, t.rayleigh, v_max, t.hertz, dt
@@ -373,15 +383,8 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     }
     // The stick count an equivalent grid would give (speeds k·Δv, one transition per diameter).
     let vs = cfg.grid.speed_axis();
-    let grid_count: usize = p
-        .critical
-        .iter()
-        .map(|c| {
-            vs.iter()
-                .filter(|&&v| v < c.v_crit || c.v_crit.is_nan() && c.low.is_finite() && v <= c.low)
-                .count()
-        })
-        .sum();
+    // Speeds at or below the highest sticking speed of each diameter stick.
+    let grid_count: usize = p.critical.iter().map(|c| vs.iter().filter(|&&v| v <= c.low).count()).sum();
     s.headline.push(format!("equivalent grid stick count ({} speeds): {grid_count}", vs.len()));
     Ok(s)
 }
