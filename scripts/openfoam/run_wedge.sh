@@ -33,6 +33,8 @@ mkdir -p "$out"
 cp "$(find vtk_xml -name 'internal.vtu' | head -n 1)" "$out/internal.vtu"
 cp "$(find vtk_legacy -name '*.vtk' | head -n 1)" "$out/internal.vtk"
 cp constant/triSurface/wedge.stl "$out/wedge.stl"
+# The same body finely triangulated (about 2 cm): deposits are counted per triangle.
+python3 "$here/make_wedge_stl.py" "$out/wedge_fine.stl" --cell 0.02
 grep -E '^(Mesh stats|    cells:|    points:|    hexahedra:|    prisms:|    polyhedra:|.*bounding box|.*Total volume|Mesh OK|.*Failed)' log.checkMesh > "$out/checkMesh.txt" || true
 tail -n 30 log.simpleFoam > "$out/simpleFoam_tail.txt"
 echo "wrote $out"

@@ -48,8 +48,9 @@ macro_rules! kinds {
             fn read(kind: &str, src: &Source, body: &str) -> Result<Option<Self>, Vec<ScenarioError>> {
                 match kind {
                     $( $name => {
-                        let cfg: $cfg = typed(src, body).map_err(|e| vec![e])?;
+                        let mut cfg: $cfg = typed(src, body).map_err(|e| vec![e])?;
                         validate(src, &cfg)?;
+                        ScenarioFolder::set_base_dir(&mut cfg, &src.base_dir());
                         Ok(Some(Scenario::$variant(cfg)))
                     } )*
                     _ => Ok(None),
@@ -62,6 +63,26 @@ macro_rules! kinds {
 kinds! {
     "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run),
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
+    "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run),
+        "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
+    "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
+        "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
+}
+
+/// Configurations that name files learn the scenario's folder, against which their relative paths are
+/// resolved at run time (validation already resolves them there).
+trait ScenarioFolder {
+    fn set_base_dir(&mut self, _dir: &Path) {}
+}
+
+impl ScenarioFolder for spatter_workflows::snow::SnowConfig {}
+
+impl ScenarioFolder for spatter_workflows::deposition::ForcesConfig {}
+
+impl ScenarioFolder for spatter_workflows::deposition::DepositionConfig {
+    fn set_base_dir(&mut self, dir: &Path) {
+        self.base_dir = Some(dir.to_owned());
+    }
 }
 
 #[allow(dead_code)]

@@ -1,3 +1,4 @@
 //! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
 
+pub mod deposition;
 pub mod snow;

@@ -90,7 +90,7 @@ impl Validate for InjectorSpec {
                     c.fail("region.points_m", "points_m must list at least one point");
                 }
                 for (i, p) in points_m.iter().enumerate() {
-                    c.element("region.points_m", i, |c| c.finite_vec("", *p));
+                    c.finite_vec(&format!("region.points_m[{i}]"), *p);
                 }
             }
             Region::Box { min_m, max_m } => {
@@ -157,14 +157,20 @@ pub struct NewParcel {
 }
 
 /// The running state of an injector.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug)]
 pub struct Injector {
     pub spec: InjectorSpec,
     /// Parcels released so far.
     pub released: u64,
     rng: Rng,
-    #[serde(skip)]
     surface: Option<SurfaceSampler>,
+}
+
+/// What a checkpoint keeps of an injector (its specification comes from the scenario).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InjectorState {
+    pub released: u64,
+    pub rng: Rng,
 }
 
 #[derive(Clone, Debug)]
@@ -190,7 +196,18 @@ impl Injector {
         Ok(inj)
     }
 
-    /// Reads the surface of a surface injector (after a checkpoint is loaded, too).
+    /// The resumable state.
+    pub fn state(&self) -> InjectorState {
+        InjectorState { released: self.released, rng: self.rng.clone() }
+    }
+
+    /// Continues from a checkpointed state.
+    pub fn restore(&mut self, s: &InjectorState) {
+        self.released = s.released;
+        self.rng = s.rng.clone();
+    }
+
+    /// Reads the surface of a surface injector.
     pub fn load_surface(&mut self, base: Option<&Path>) -> Result<(), InjectError> {
         if let Region::Surface { file, scale, .. } = &self.spec.region {
             let path = match base {

@@ -200,7 +200,7 @@ impl Body {
 
     /// Estimates the wall shear stress on every triangle as τ_w ≈ μ |u_t(h)|/h from the fluid velocity
     /// `h` off the centroid on the side the normal points to (where a closed body's fluid is).
-    pub fn estimate_wall_shear(&mut self, mu: f64, h: f64, velocity: impl Fn(Vec3) -> Option<Vec3>) {
+    pub fn estimate_wall_shear(&mut self, mu: f64, h: f64, mut velocity: impl FnMut(Vec3) -> Option<Vec3>) {
         for t in 0..self.mesh.triangles.len() {
             let n = self.mesh.normal(t);
             let p = self.mesh.centroid(t) + h * n;

@@ -1,0 +1,366 @@
+//! Running a `deposition` scenario: build the field, bodies and injectors, track, write the deposit maps.
+//!
+//! Outputs in the run folder:
+//!
+//! * `balance.csv` — every `output.interval_s`: parcels and mass airborne, deposited, escaped, injected;
+//! * `parcels.pvd` + `parcels/parcels_NNNNN.vtu` — parcel snapshots (position, velocity, diameter, count,
+//!   status, id);
+//! * `bodies/<name>.vtu` — each body's triangles with the per-triangle deposit and impact statistics;
+//! * `<name>_deposit.png` — the chosen statistic on the body, seen from the body's view direction;
+//! * `deposit_summary.csv` — one row per body.
+//!
+//! Stopping (Ctrl-C) writes `checkpoint.bin` after a whole step; resuming continues from it and gives
+//! the same files as an uninterrupted run.
+
+use super::config::{DepositionConfig, PictureQuantity};
+use serde::{Deserialize, Serialize};
+use spatter_core::control::Finished;
+use spatter_core::mesh::TriMesh;
+use spatter_core::{Aabb, Vec3};
+use spatter_flow::field::analytic::AnalyticSet;
+use spatter_flow::field::imported::{ImportOptions, ImportedField};
+use spatter_flow::field::tetmesh::NONE;
+use spatter_flow::field::{Field, FieldError, FlowField};
+use spatter_flow::forces::model::ForceModel;
+use spatter_flow::tracker::inject::{InjectError, Injector, InjectorState};
+use spatter_flow::tracker::walls::{Body, WallRule, WallRuleError, WallRuleSpec};
+use spatter_flow::tracker::{Status, TrackError, TrackSettings, Tracker, TrackerState};
+use spatter_io::csv::CsvSeries;
+use spatter_io::pvd::PvdSeries;
+use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::vtu::Vtu;
+use std::path::PathBuf;
+
+/// Why a deposition run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum DepositionError {
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    #[error("body `{name}`: {message}")]
+    Body { name: String, message: String },
+    #[error(transparent)]
+    Wall(#[from] WallRuleError),
+    #[error(transparent)]
+    Inject(#[from] InjectError),
+    #[error(transparent)]
+    Track(#[from] TrackError),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("checkpoint: {0}")]
+    Checkpoint(String),
+}
+
+/// What `checkpoint.bin` holds.
+#[derive(Serialize, Deserialize)]
+struct Checkpoint {
+    state: TrackerState,
+    injectors: Vec<InjectorState>,
+    next_output: u64,
+    csv_bytes: u64,
+}
+
+const BALANCE_COLUMNS: [&str; 9] = [
+    "time_s",
+    "airborne_parcels",
+    "deposited_parcels",
+    "escaped_parcels",
+    "injected_kg",
+    "airborne_kg",
+    "deposited_kg",
+    "escaped_kg",
+    "balance_residual_kg",
+];
+
+/// Builds the flow field of `cfg`.
+pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
+    let f = &cfg.flow;
+    if !f.analytic.is_empty() {
+        return Ok(Field::Analytic(AnalyticSet { parts: f.analytic.clone(), turbulence: f.turbulence }));
+    }
+    let files: Vec<(f64, PathBuf)> = if let Some(v) = &f.vtk {
+        vec![(0.0, cfg.resolve(v))]
+    } else if let Some(s) = &f.series {
+        spatter_flow::vtk::series::read_series(&cfg.resolve(s)).map_err(FieldError::from)?
+    } else {
+        f.files.iter().map(|t| (t.time_s, cfg.resolve(&t.file))).collect()
+    };
+    let opts = ImportOptions {
+        interpolation: f.interpolation,
+        names: f.arrays.clone(),
+        length_scale: f.length_scale,
+        period: f.period_s,
+    };
+    Ok(Field::Imported(Box::new(ImportedField::load(&files, &opts)?)))
+}
+
+/// Loads the bodies of `cfg`; wall shear is estimated from `field` where a rule needs it.
+pub fn build_bodies(cfg: &DepositionConfig, field: &Field) -> Result<Vec<Body>, DepositionError> {
+    let mut out = Vec::new();
+    for b in &cfg.bodies {
+        let mut mesh = TriMesh::load(&cfg.resolve(&b.file), b.scale)
+            .map_err(|e| DepositionError::Body { name: b.name.clone(), message: e.to_string() })?;
+        if b.translate_m != Vec3::ZERO {
+            let t = b.translate_m;
+            mesh.map_vertices(|v| v + t);
+        }
+        let rule = WallRule::from_spec(&b.wall, cfg.base_dir.as_deref())?;
+        let mut body = Body::new(b.name.clone(), mesh, rule);
+        if matches!(b.wall, WallRuleSpec::RegimeMap { max_wall_shear_pa: Some(_), .. }) {
+            let mut hint = NONE;
+            body.estimate_wall_shear(cfg.fluid.viscosity, b.shear_probe_distance_m, |p| {
+                field.sample(p, 0.0, &mut hint, false).map(|s| s.u)
+            });
+        }
+        out.push(body);
+    }
+    Ok(out)
+}
+
+fn balance_row(tr: &Tracker<Field>) -> [f64; 9] {
+    let count = |s: Status| tr.state.parcels.iter().filter(|p| p.status == s).count() as f64;
+    let b = &tr.state.balance;
+    let air = tr.airborne_mass().value();
+    let (inj, rhs) = tr.mass_balance();
+    [
+        tr.state.time,
+        count(Status::Airborne),
+        count(Status::Deposited),
+        count(Status::Escaped),
+        b.injected.value(),
+        air,
+        b.deposited.value(),
+        b.escaped.value(),
+        inj - rhs,
+    ]
+}
+
+fn write_parcels(tr: &Tracker<Field>, ctx: &RunContext, k: u64, pvd: &mut PvdSeries) -> std::io::Result<()> {
+    let ps: Vec<_> = tr.state.parcels.iter().filter(|p| p.status != Status::Escaped).collect();
+    let pos: Vec<Vec3> = ps.iter().map(|p| p.pos).collect();
+    let rel = format!("parcels/parcels_{k:05}.vtu");
+    Vtu::point_cloud(&pos)
+        .point_vector("velocity_m_s", &ps.iter().map(|p| p.vel).collect::<Vec<_>>())
+        .point_scalar("diameter_m", &ps.iter().map(|p| p.diameter).collect::<Vec<_>>())
+        .point_scalar("particles", &ps.iter().map(|p| p.count).collect::<Vec<_>>())
+        .point_int(
+            "status",
+            &ps.iter().map(|p| if p.status == Status::Airborne { 0 } else { 1 }).collect::<Vec<_>>(),
+        )
+        .point_int("id", &ps.iter().map(|p| p.id as i64).collect::<Vec<_>>())
+        .write(&ctx.dir.path(&rel))?;
+    pvd.push(tr.state.time, &rel)
+}
+
+/// Runs a deposition scenario.
+pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, DepositionError> {
+    let field = build_field(cfg)?;
+    let bodies = build_bodies(cfg, &field)?;
+    let settings = TrackSettings {
+        dt: cfg.time.dt_s,
+        domain: cfg.domain.map(|d| Aabb::new(d.min_m, d.max_m)),
+        dispersion: cfg.dispersion,
+        max_bounces: 8,
+    };
+    if cfg.dispersion.is_some() && !field.has_turbulence() {
+        tracing::warn!("dispersion is on but the flow field has no k and ε: the random walk does nothing");
+    }
+    let model = ForceModel::new(cfg.fluid, cfg.forces.clone());
+    let mut tr = Tracker::new(field, model, settings, bodies);
+    let base = cfg.base_dir.as_deref();
+    let mut injectors: Vec<Injector> = cfg
+        .injectors
+        .iter()
+        .enumerate()
+        .map(|(i, s)| Injector::new(s.clone(), i as u64, base))
+        .collect::<Result<_, _>>()?;
+    let csv_path = ctx.dir.path("balance.csv");
+    let pvd_path = ctx.dir.path("parcels.pvd");
+    let ckpt = ctx.dir.checkpoint_path();
+    let mut next_output = 0u64;
+    let (mut csv, mut pvd) = if ctx.resume && ckpt.is_file() {
+        let c: Checkpoint =
+            spatter_io::checkpoint::load(&ckpt).map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
+        if c.injectors.len() != injectors.len() || c.state.deposits.len() != tr.bodies.len() {
+            return Err(DepositionError::Checkpoint(
+                "the checkpoint was written by a scenario with other injectors or bodies".into(),
+            ));
+        }
+        tr.state = c.state;
+        for (inj, st) in injectors.iter_mut().zip(&c.injectors) {
+            inj.restore(st);
+        }
+        next_output = c.next_output;
+        let mut pvd = PvdSeries::load_or_new(&pvd_path)?;
+        pvd.truncate_after(tr.state.time)?;
+        (CsvSeries::resume(&csv_path, &BALANCE_COLUMNS, c.csv_bytes)?, pvd)
+    } else {
+        (CsvSeries::create(&csv_path, &BALANCE_COLUMNS)?, PvdSeries::new(&pvd_path))
+    };
+    let dt = cfg.time.dt_s;
+    let n_steps = (cfg.time.duration_s / dt).round() as u64;
+    let interval = cfg.output.interval_s;
+    let injection_end = cfg.injectors.iter().map(|i| i.end_s).fold(0.0, f64::max);
+    let output_due = |t: f64, k: u64| t >= k as f64 * interval - 1e-9 * dt;
+    let write_outputs =
+        |tr: &Tracker<Field>, k: &mut u64, csv: &mut CsvSeries, pvd: &mut PvdSeries| -> std::io::Result<()> {
+            csv.row(&balance_row(tr))?;
+            if cfg.output.parcels {
+                write_parcels(tr, ctx, *k, pvd)?;
+            }
+            *k += 1;
+            Ok(())
+        };
+    if tr.state.step == 0 && next_output == 0 {
+        write_outputs(&tr, &mut next_output, &mut csv, &mut pvd)?;
+    }
+    let mut finished = Finished::Completed;
+    let mut last_written_step = u64::MAX;
+    while tr.state.step < n_steps {
+        if ctx.control.stop_requested() {
+            csv.flush()?;
+            let c = Checkpoint {
+                state: tr.state.clone(),
+                injectors: injectors.iter().map(Injector::state).collect(),
+                next_output,
+                csv_bytes: csv.bytes_written(),
+            };
+            spatter_io::checkpoint::save(&ckpt, &c)
+                .map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
+            finished = Finished::Interrupted;
+            break;
+        }
+        let t_end = tr.state.time + dt;
+        for (i, inj) in injectors.iter_mut().enumerate() {
+            inj.release(t_end, |p| tr.add(p, i as u16));
+        }
+        tr.step()?;
+        if output_due(tr.state.time, next_output) {
+            write_outputs(&tr, &mut next_output, &mut csv, &mut pvd)?;
+            last_written_step = tr.state.step;
+        }
+        ctx.control.progress(tr.state.step, n_steps);
+        let all_released = injectors.iter().all(|i| i.released == i.total());
+        if cfg.time.stop_when_settled && all_released && tr.state.time >= injection_end && tr.airborne() == 0
+        {
+            break;
+        }
+    }
+    if finished == Finished::Interrupted {
+        let mut s = RunSummary::new(Finished::Interrupted);
+        s.headline.push(format!(
+            "stopped at t = {:.6} s (step {} of {n_steps}); checkpoint written to {}",
+            tr.state.time,
+            tr.state.step,
+            ckpt.display()
+        ));
+        return Ok(s);
+    }
+    if last_written_step != tr.state.step {
+        write_outputs(&tr, &mut next_output, &mut csv, &mut pvd)?;
+    }
+    csv.flush()?;
+    let mut summary = RunSummary::new(Finished::Completed);
+    summary.artifacts.push(("mass balance".into(), csv_path.clone()));
+    if cfg.output.parcels {
+        summary.artifacts.push(("parcel snapshots".into(), pvd_path.clone()));
+    }
+    write_bodies(cfg, &tr, ctx, &mut summary)?;
+    let b = &tr.state.balance;
+    let (inj, rhs) = tr.mass_balance();
+    let line = format!(
+        "t = {:.6} s: injected {} parcels ({:.6e} kg) = deposited {} ({:.6e} kg) + escaped {} ({:.6e} kg) + airborne {} ({:.6e} kg); residual {:e} kg",
+        tr.state.time,
+        b.n_injected,
+        inj,
+        b.n_deposited,
+        b.deposited.value(),
+        b.n_escaped,
+        b.escaped.value(),
+        tr.airborne(),
+        tr.airborne_mass().value(),
+        inj - rhs
+    );
+    tracing::info!("{line}");
+    summary.headline.insert(0, line);
+    let _ = std::fs::remove_file(&ckpt);
+    Ok(summary)
+}
+
+fn write_bodies(
+    cfg: &DepositionConfig,
+    tr: &Tracker<Field>,
+    ctx: &RunContext,
+    summary: &mut RunSummary,
+) -> Result<(), DepositionError> {
+    let mut rows = Vec::new();
+    for (k, (body, spec)) in tr.bodies.iter().zip(&cfg.bodies).enumerate() {
+        let d = &tr.state.deposits[k];
+        let m = &body.mesh;
+        let areas: Vec<f64> = (0..m.triangles.len()).map(|t| m.area(t)).collect();
+        let mpa = d.mass_per_area(&areas);
+        let rel = format!("bodies/{}.vtu", body.name);
+        Vtu::triangles(&m.vertices, &m.triangles)
+            .cell_scalar("deposited_mass_kg", &d.mass)
+            .cell_scalar("mass_per_area_kg_m2", &mpa)
+            .cell_scalar("deposited_particles", &d.particles)
+            .cell_int("impacts", &d.impacts.iter().map(|&i| i as i64).collect::<Vec<_>>())
+            .cell_scalar("impact_particles", &d.impact_particles)
+            .cell_scalar("mean_normal_speed_m_s", &d.mean_vn())
+            .cell_scalar("mean_tangential_speed_m_s", &d.mean_vt())
+            .cell_scalar("mean_impact_angle_deg", &d.mean_angle_deg())
+            .cell_scalar("wall_shear_estimate_pa", &body.wall_shear)
+            .write(&ctx.dir.path(&rel))?;
+        summary.artifacts.push((format!("{} deposit (VTU)", body.name), ctx.dir.path(&rel)));
+        let (values, label) = match cfg.output.picture_quantity {
+            PictureQuantity::MassPerArea => (mpa.clone(), "deposited mass per area [kg/m²]"),
+            PictureQuantity::Impacts => (d.impacts.iter().map(|&i| i as f64).collect(), "impacts [parcels]"),
+            PictureQuantity::MeanNormalSpeed => (d.mean_vn(), "mean normal impact speed [m/s]"),
+        };
+        let png = ctx.dir.path(&format!("{}_deposit.png", body.name));
+        spatter_io::plot::mesh_map_png(
+            &png,
+            m,
+            &values,
+            spec.view_direction,
+            spec.view_up,
+            &format!("{}: {}", body.name, label.split(" [").next().unwrap_or(label)),
+            label,
+        )?;
+        summary.artifacts.push((format!("{} deposit (PNG)", body.name), png));
+        let mass: f64 = d.mass.iter().sum();
+        let area: f64 = areas.iter().sum();
+        let impacts: u64 = d.impacts.iter().sum();
+        let peak = mpa.iter().copied().fold(0.0, f64::max);
+        summary.headline.push(format!(
+            "{}: deposited {:.4e} kg on {:.4e} m² ({} impacts), peak {:.4e} kg/m²",
+            body.name, mass, area, impacts, peak
+        ));
+        rows.push(vec![
+            body.name.clone(),
+            spatter_io::fmt_f64(mass),
+            spatter_io::fmt_f64(d.particles.iter().sum()),
+            impacts.to_string(),
+            spatter_io::fmt_f64(area),
+            spatter_io::fmt_f64(mass / area),
+            spatter_io::fmt_f64(peak),
+        ]);
+    }
+    if !rows.is_empty() {
+        let p = ctx.dir.path("deposit_summary.csv");
+        spatter_io::csv::write_table(
+            &p,
+            &[
+                "body",
+                "deposited_kg",
+                "deposited_particles",
+                "impacts",
+                "area_m2",
+                "mean_mass_per_area_kg_m2",
+                "peak_mass_per_area_kg_m2",
+            ],
+            &rows,
+        )?;
+        summary.artifacts.push(("deposit summary".into(), p));
+    }
+    Ok(())
+}

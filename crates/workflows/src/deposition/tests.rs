@@ -1,0 +1,150 @@
+use super::config::*;
+use super::run;
+use spatter_core::control::{StopAfterPolls, Unattended};
+use spatter_core::distribution::SizeDistribution;
+use spatter_core::mesh::TriMesh;
+use spatter_core::regime::{PolyFit, RegimeMap};
+use spatter_core::Vec3;
+use spatter_flow::field::analytic::{AnalyticField, ConstantTurbulence};
+use spatter_flow::tracker::inject::{InjectorSpec, Region};
+use spatter_flow::tracker::walls::{Restitution, WallRuleSpec};
+use spatter_io::run::{RunContext, RunDir};
+use std::path::Path;
+
+/// A plate at z = 0 under a slanted flow, a regime map with v_crit = 1.5 m/s, a box injector.
+fn scenario(dir: &Path) -> DepositionConfig {
+    let mut plate = TriMesh::rectangle(1.0, 1.0, 0.0, 8, 8);
+    plate.map_vertices(|v| v - Vec3::new(0.5, 0.5, 0.0));
+    std::fs::write(dir.join("plate.stl"), plate.to_binary_stl()).unwrap();
+    let fit = PolyFit {
+        x: "diameter_m".into(),
+        y: "critical_normal_speed_m_s".into(),
+        log10: true,
+        coefficients: vec![1.5f64.log10()],
+        x_range: [1e-6, 1e-3],
+        rms_relative_error: 0.0,
+    };
+    let map = RegimeMap {
+        schema: RegimeMap::SCHEMA.into(),
+        description: "test".into(),
+        v_crit_of_d: fit.clone(),
+        d_crit_of_vn: fit,
+        interface: vec![],
+    };
+    std::fs::write(dir.join("map.json"), serde_json::to_string(&map).unwrap()).unwrap();
+    DepositionConfig {
+        fluid: Default::default(),
+        flow: FlowSpec {
+            analytic: vec![AnalyticField::Uniform { velocity: Vec3::new(3.0, 0.0, -2.0) }],
+            turbulence: Some(ConstantTurbulence { k: 0.3, epsilon: 1.0 }),
+            length_scale: 1.0,
+            ..Default::default()
+        },
+        forces: Default::default(),
+        dispersion: Some(Default::default()),
+        bodies: vec![BodySpec {
+            name: "plate".into(),
+            file: "plate.stl".into(),
+            scale: 1.0,
+            translate_m: Vec3::ZERO,
+            wall: WallRuleSpec::RegimeMap {
+                file: "map.json".into(),
+                bounce: Restitution { normal: 0.4, tangential: 0.9 },
+                max_tangential_speed_m_s: None,
+                max_wall_shear_pa: None,
+            },
+            shear_probe_distance_m: 1e-3,
+            view_direction: Vec3::new(0.0, 0.0, -1.0),
+            view_up: Vec3::Y,
+        }],
+        injectors: vec![InjectorSpec {
+            name: "cloud".into(),
+            region: Region::Box { min_m: Vec3::new(-0.45, -0.3, 0.1), max_m: Vec3::new(-0.3, 0.3, 0.4) },
+            size: SizeDistribution::LogNormal { median: 40e-6, geometric_std: 1.5 },
+            density: 917.0,
+            velocity: Vec3::new(3.0, 0.0, -2.0),
+            normal_speed: 0.0,
+            velocity_spread: 0.0,
+            parcels: 3000,
+            start_s: 0.0,
+            end_s: 0.05,
+            particles_per_parcel: None,
+            mass_per_parcel_kg: None,
+            mass_flow_kg_s: Some(1e-5),
+            seed: 4,
+        }],
+        time: TimeSpec { dt_s: 5e-4, duration_s: 0.4, stop_when_settled: true },
+        domain: Some(DomainBox { min_m: Vec3::new(-0.6, -0.6, -0.1), max_m: Vec3::new(0.6, 0.6, 0.6) }),
+        output: OutputSpec {
+            interval_s: 0.02,
+            parcels: true,
+            picture_quantity: PictureQuantity::MassPerArea,
+        },
+        base_dir: Some(dir.to_owned()),
+    }
+}
+
+fn run_in(
+    cfg: &DepositionConfig,
+    out: &Path,
+    control: &dyn spatter_core::control::RunControl,
+    resume: bool,
+) -> spatter_io::run::RunSummary {
+    let rd = RunDir::create(out).unwrap();
+    let ctx = RunContext { dir: &rd, control, resume };
+    run(cfg, &ctx).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = scenario(dir.path());
+    let a = dir.path().join("a");
+    let s = run_in(&cfg, &a, &Unattended, false);
+    assert_eq!(s.finished, spatter_core::control::Finished::Completed);
+    assert!(s.headline[0].contains("residual 0e0 kg"), "{}", s.headline[0]);
+    let b = dir.path().join("b");
+    let s = run_in(&cfg, &b, &StopAfterPolls::new(137), false);
+    assert_eq!(s.finished, spatter_core::control::Finished::Interrupted);
+    assert!(b.join("checkpoint.bin").is_file());
+    let s = run_in(&cfg, &b, &StopAfterPolls::new(100), true);
+    assert_eq!(s.finished, spatter_core::control::Finished::Interrupted, "stopped twice");
+    let s = run_in(&cfg, &b, &Unattended, true);
+    assert_eq!(s.finished, spatter_core::control::Finished::Completed);
+    for f in
+        ["balance.csv", "bodies/plate.vtu", "deposit_summary.csv", "parcels.pvd", "parcels/parcels_00005.vtu"]
+    {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f} differs after resume"
+        );
+    }
+    assert!(!b.join("checkpoint.bin").exists());
+    // Something stuck and something bounced.
+    let vtu = spatter_io::vtu::read(&a.join("bodies/plate.vtu")).unwrap();
+    let _ = vtu;
+    let summary = std::fs::read_to_string(a.join("deposit_summary.csv")).unwrap();
+    let row: Vec<&str> = summary.lines().nth(1).unwrap().split(',').collect();
+    let deposited: f64 = row[1].parse().unwrap();
+    let impacts: u64 = row[3].parse().unwrap();
+    assert!(deposited > 0.0 && impacts > 0);
+    assert!(a.join("plate_deposit.png").is_file());
+}
+
+#[test]
+fn bad_inputs_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = scenario(dir.path());
+    cfg.flow.vtk = Some("nowhere.vtu".into());
+    cfg.injectors[0].end_s = -1.0;
+    cfg.time.dt_s = 0.0;
+    let errs = spatter_core::check::Checker::run(&cfg, Some(dir.path())).unwrap_err();
+    let keys: Vec<&str> = errs.iter().map(|e| e.key.as_str()).collect();
+    assert!(keys.contains(&"flow"), "{errs:?}");
+    assert!(keys.contains(&"flow.vtk"), "{errs:?}");
+    assert!(keys.contains(&"injectors[0].end_s"), "{errs:?}");
+    assert!(keys.contains(&"time.dt_s"), "{errs:?}");
+    let e = errs.iter().find(|e| e.key == "time.dt_s").unwrap();
+    assert_eq!(e.message, "dt_s = 0 must be a positive number");
+}
