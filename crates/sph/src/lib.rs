@@ -10,6 +10,7 @@
 //! * [`fill`] — fluid initialisation on a lattice (box minus solids, flood fill);
 //! * [`drag`] — air drag;
 //! * [`scene`] — the `sph` scenario kind: configuration, outputs, checkpoint/resume;
+//! * [`sessile`] — contact angle of a sessile drop for a given adhesion (calibration);
 //! * [`validation`] — reference cases for `spatter validate`;
 //! * [`sim`] — the [`Simulation`] and its time step (velocity Verlet with one force evaluation per step).
 //!
@@ -27,6 +28,7 @@ pub mod neighbours;
 pub mod params;
 mod pass;
 pub mod scene;
+pub mod sessile;
 pub mod sim;
 pub mod validation;
 

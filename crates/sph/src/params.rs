@@ -125,6 +125,33 @@ impl SphParams {
         factor * u_max
     }
 
+    /// Akinci adhesion β per unit of a wall's `adhesion` factor: β = factor · γ · M_C/M_A with
+    /// `M_X = ∫₀^R r^d X(r) dr` (d the dimension). A wall of factor 1 then pulls on the fluid near it (in the
+    /// virial sense) as strongly as the fluid pulls on itself — the parameterisation of the thesis's
+    /// Preonlab runs ("adhesion factor × cohesion", digest §2.10.3): 1 wets like the liquid itself, 0 does not
+    /// attract at all, and the sessile-drop utility maps factors to contact angles.
+    pub fn adhesion_per_factor(&self) -> f64 {
+        let gamma = self.cohesion_coefficient();
+        if gamma == 0.0 {
+            return 0.0;
+        }
+        let support = self.kernel().support();
+        let d = self.dim.count();
+        let moment = |f: &dyn Fn(f64) -> f64| {
+            let n = 4000;
+            let dr = support / n as f64;
+            (0..n)
+                .map(|i| {
+                    let r = (i as f64 + 0.5) * dr;
+                    r.powi(d) * f(r) * dr
+                })
+                .sum::<f64>()
+        };
+        let mc = moment(&|r| crate::kernel::akinci_cohesion(r, support));
+        let ma = moment(&|r| crate::kernel::akinci_adhesion(r, support));
+        gamma * mc / ma
+    }
+
     /// The Akinci cohesion coefficient γ that gives surface tension σ for a flat interface in the
     /// continuum limit (Kirkwood–Buff/Fowler integral of the pair potential, uniform density):
     /// 3D `σ = (π/8) ρ₀² γ ∫ r⁴ C(r) dr`, 2D `σ = (ρ₀²/3) γ ∫ r³ C(r) dr`.

@@ -424,7 +424,10 @@ impl Simulation {
             g: p.gravity,
             gamma_st,
             curv: p.curvature_weight * (2.0 * p.spacing / support).powi(d),
-            beta: self.boundary.parts.iter().map(|q| q.adhesion * gamma_st).collect(),
+            beta: {
+                let per_factor = p.adhesion_per_factor();
+                self.boundary.parts.iter().map(|q| q.adhesion * per_factor).collect()
+            },
             drag: p.drag,
             shift_a: p.shifting,
             dt,
@@ -767,7 +770,14 @@ impl Simulation {
         let dt_f = if st.max_acc > 0.0 { p.cfl * (h / st.max_acc).sqrt() } else { f64::INFINITY };
         let dt_v =
             if p.kinematic_viscosity > 0.0 { 0.125 * h * h / p.kinematic_viscosity } else { f64::INFINITY };
-        self.dt = dt_a.min(dt_f).min(dt_v).min(p.max_dt);
+        // Capillary waves (Brackbill, Kothe & Zemach 1992): dt < √(ρ dp³ / (2πσ)); half of it.
+        let dt_s = if p.surface_tension > 0.0 {
+            0.5 * (p.rest_density * p.spacing.powi(3) / (2.0 * std::f64::consts::PI * p.surface_tension))
+                .sqrt()
+        } else {
+            f64::INFINITY
+        };
+        self.dt = dt_a.min(dt_f).min(dt_v).min(dt_s).min(p.max_dt);
         self.last.max_speed = vmax;
         self.last.max_acc = st.max_acc;
         self.last.interactions = st.interactions;

@@ -16,6 +16,7 @@ pub fn validation_cases() -> Vec<Case> {
         Case { name: "sph_conservation", run: conservation },
         Case { name: "sph_dam_break_surge_front", run: dam_break_front },
         Case { name: "sph_dam_break_wall_pressure", run: dam_break_pressure },
+        Case { name: "sph_sessile_drop", run: sessile_drop_angles },
     ]
 }
 
@@ -377,6 +378,52 @@ pub fn dam_break_pressure(quick: bool) -> Vec<Check> {
     ]
 }
 
+/// Sessile drops on walls of increasing adhesion: the static contact angle decreases monotonically, and
+/// follows Young–Dupré for pair-potential adhesion, `1 + cos θ = 2f` (work of adhesion f·2σ for a wall
+/// that attracts the liquid f times as strongly as the liquid attracts itself; Girifalco & Good 1957).
+/// The angle is read from the cap geometry to about ±dp/R per length, so the tolerance is 2·dp/R rad.
+pub fn sessile_drop_angles(quick: bool) -> Vec<Check> {
+    use crate::sessile::{sessile_drop, SessileDrop};
+    let case = "sph_sessile_drop";
+    let factors = [0.5, 0.75, 1.0];
+    let mut angles = Vec::new();
+    let mut res = 8;
+    for &f in &factors {
+        let mut d = SessileDrop::water(if quick { Dim::Two } else { Dim::Three }, f);
+        if quick {
+            d.resolution = 8;
+            d.capillary_times = 8.0;
+        }
+        res = d.resolution;
+        let r = sessile_drop(&d).expect("sessile drop runs");
+        angles.push(r.contact_angle_deg);
+    }
+    let tol = (2.0 / res as f64).to_degrees();
+    let mut checks = Vec::new();
+    for k in 0..factors.len() - 1 {
+        checks.push(Check::absolute(
+            case,
+            format!("increase of θ from adhesion {} to {} [deg]", factors[k], factors[k + 1]),
+            0.0,
+            (angles[k + 1] - angles[k]).max(0.0),
+            0.0,
+            "contact angle decreases with adhesion",
+        ));
+    }
+    for (k, &f) in factors.iter().enumerate().take(2) {
+        let want = (2.0 * f - 1.0f64).acos().to_degrees();
+        checks.push(Check::absolute(
+            case,
+            format!("θ at adhesion {f} [deg]"),
+            want,
+            angles[k],
+            tol,
+            "Young–Dupré with pair-potential adhesion, 1 + cos θ = 2f",
+        ));
+    }
+    checks
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -416,6 +463,11 @@ mod tests {
     #[test]
     fn dam_break_front_quick() {
         assert_all_pass(&dam_break_front(true));
+    }
+
+    #[test]
+    fn sessile_drop_quick() {
+        assert_all_pass(&sessile_drop_angles(true));
     }
 
     #[test]
