@@ -582,16 +582,31 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
             "stick_probability",
             "wilson_low",
             "wilson_high",
+            "at_rest",
+            "at_rest_probability",
+            "moving_in_contact",
         ],
     )?;
-    let (mut est, mut lo_pts, mut hi_pts) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut est, mut lo_pts, mut hi_pts, mut rest_pts) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let ratio = cfg.integration.static_slip_ratio;
+    // A stuck particle is "at rest" when its energy proved it bound or it no longer moves tangentially; on
+    // a rough wall many grains that keep a contact at the check time still roll or slide across the bed.
+    let at_rest = |r: &ImpactRecord| {
+        r.sticks()
+            && (r.result.decision == super::impact::Decision::Bound
+                || r.result.tangential_speed <= ratio * r.normal_speed)
+    };
     let v_scale = cfg.grid.velocity_scale_m_s;
     let mut any_stick_max: Option<f64> = None;
     for (i, &v) in speeds.iter().enumerate() {
-        let k = p.records[i * n..(i + 1) * n].iter().filter(|r| r.sticks()).count();
+        let recs = &p.records[i * n..(i + 1) * n];
+        let k = recs.iter().filter(|r| r.sticks()).count();
+        let rest = recs.iter().filter(|r| at_rest(r)).count();
         let (ph, lo, hi) = wilson_interval(k, n, rw.confidence);
-        csv.row(&[v, v / v_scale, n as f64, k as f64, ph, lo, hi])?;
+        let p_rest = rest as f64 / n as f64;
+        csv.row(&[v, v / v_scale, n as f64, k as f64, ph, lo, hi, rest as f64, p_rest, (k - rest) as f64])?;
         est.push((v, ph));
+        rest_pts.push((v, p_rest));
         lo_pts.push((v, lo));
         hi_pts.push((v, hi));
         if k > 0 {
@@ -611,10 +626,11 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     )
     .log_x()
     .y_range(-0.02, 1.02)
-    .line_colored("estimate", &est, output::STICK_RGB)
+    .line_colored("stick probability (contact at check time)", &est, output::STICK_RGB)
     .markers("", &est, output::STICK_RGB)
     .dashed(&format!("Wilson {} % interval", 100.0 * rw.confidence), &lo_pts, (120, 120, 120))
-    .dashed("", &hi_pts, (120, 120, 120));
+    .dashed("", &hi_pts, (120, 120, 120))
+    .line_colored("stuck and at rest", &rest_pts, (120, 0, 160));
     if v_flat.v_crit.is_finite() {
         chart = chart.dashed(
             "flat-wall v_crit",
@@ -632,6 +648,11 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
         bed.nominal_fraction,
         bed.top,
         bed.width
+    ));
+    let moving: usize = p.records.iter().filter(|r| r.sticks() && !at_rest(r)).count();
+    s.headline.push(format!(
+        "{moving} of {} stuck impacts were still rolling or sliding across the bed at the check time",
+        p.records.iter().filter(|r| r.sticks()).count()
     ));
     s.headline.push(format!(
         "{} impacts per speed at {} speeds; highest speed with a stick: {}; flat-wall v_crit for the same particle {:.4} m/s",
