@@ -61,6 +61,10 @@ macro_rules! kinds {
 }
 
 kinds! {
+    "dem" => Dem(spatter_dem::SceneConfig, spatter_dem::run),
+        "A DEM scene: materials, particles (fills, injectors), walls (planes, cylinders, STL meshes with motion).";
+    "sph" => Sph(spatter_sph::scene::SphConfig, spatter_sph::scene::run),
+        "Free-surface water (WCSPH) with walls and moving bodies: wetting maps, splash heights, probes.";
     "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run),
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
     "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run),
@@ -76,6 +80,25 @@ trait ScenarioFolder {
 }
 
 impl ScenarioFolder for spatter_workflows::snow::SnowConfig {}
+
+impl ScenarioFolder for spatter_dem::SceneConfig {
+    fn set_base_dir(&mut self, dir: &Path) {
+        self.base_dir = Some(dir.to_owned());
+    }
+}
+
+impl ScenarioFolder for spatter_sph::scene::SphConfig {
+    /// Makes wall-mesh and motion-table paths absolute.
+    fn set_base_dir(&mut self, dir: &Path) {
+        let absolute = |p: &mut Option<std::path::PathBuf>| {
+            if let Some(f) = p.as_mut().filter(|f| f.is_relative()) {
+                *f = dir.join(&*f);
+            }
+        };
+        self.walls.iter_mut().for_each(|w| absolute(&mut w.file));
+        self.motions.iter_mut().for_each(|m| absolute(&mut m.file));
+    }
+}
 
 impl ScenarioFolder for spatter_workflows::deposition::ForcesConfig {}
 
