@@ -60,6 +60,13 @@ pub fn bench_field(n: usize) -> Result<ImportedField, FieldError> {
     ImportedField::from_dataset(&ds, &ImportOptions::default())
 }
 
+/// CPU time of the calling thread \[ns\] (Linux `/proc/thread-self/schedstat`), to tell a loaded machine
+/// from a slow tracker: with one worker thread, parcel-steps per CPU-second is what an idle core does.
+fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
 fn mesh_bytes(m: &TetMesh) -> usize {
     m.points.len() * 24 + m.tets.len() * (16 + 16 + 4)
 }
@@ -93,9 +100,15 @@ pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
             .num_threads(threads)
             .build()
             .map_err(|e| FieldError::Config(e.to_string()))?;
-        let (rate, step_ms, loc_ms) = pool.install(|| {
+        let (rate, step_ms, loc_ms, cpu_rate, sort_ms) = pool.install(|| {
             let model = ForceModel::new(Fluid::default(), ForceSwitches::default());
-            let settings = TrackSettings { dt: 1e-3, domain: None, dispersion: None, max_bounces: 8 };
+            let settings = TrackSettings {
+                dt: 1e-3,
+                domain: None,
+                dispersion: None,
+                max_bounces: 8,
+                resort_interval: 20,
+            };
             let mut tr = Tracker::new(&field, model, settings, vec![]);
             for &x in &starts {
                 tr.add(
@@ -103,13 +116,22 @@ pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
                     0,
                 );
             }
-            // Warm-up: the first step finds every parcel through the bins.
+            // Warm-up: the first step finds every parcel through the bins; then the periodic re-sort by
+            // cell that the tracker does every `resort_interval` steps (timed separately).
             let _ = tr.step();
             let t = Instant::now();
+            tr.sort_parcels();
+            let sort_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let cpu0 = thread_cpu_ns();
             for _ in 0..steps {
                 let _ = tr.step();
             }
             let step_s = t.elapsed().as_secs_f64() / steps as f64;
+            let cpu_s = match (cpu0, thread_cpu_ns()) {
+                (Some(a), Some(b)) if threads == 1 => Some((b - a) as f64 * 1e-9 / steps as f64),
+                _ => None,
+            };
             // Location alone, from the state the next step starts in.
             let snapshot: Vec<(Vec3, u32)> =
                 tr.state.parcels.iter().map(|p: &Parcel| (p.pos, p.hint)).collect();
@@ -130,15 +152,18 @@ pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
             let airborne = tr.airborne();
             let rate = airborne as f64 / step_s;
             let _ = found;
-            (rate, step_s * 1e3, loc_s * 1e3)
+            (rate, step_s * 1e3, loc_s * 1e3, cpu_s.map(|c| airborne as f64 / c), sort_s * 1e3)
         });
+        let (rate, step_ms, loc_ms, cpu_rate, sort_ms) = (rate, step_ms, loc_ms, cpu_rate, sort_ms);
         lines.push(format!(
-            "track: {threads} thread{}: {:.3e} parcel-steps/s ({:.1} ms per step; point location {:.1} ms = {:.0} % of it)",
+            "track: {threads} thread{}: {:.3e} parcel-steps/s ({:.1} ms per step; point location {:.1} ms = {:.0} % of it; re-sort {:.1} ms every 20 steps){}",
             if threads == 1 { "" } else { "s" },
             rate,
             step_ms,
             loc_ms,
-            100.0 * loc_ms / step_ms
+            100.0 * loc_ms / step_ms,
+            sort_ms,
+            cpu_rate.map(|r| format!("; {r:.3e} parcel-steps per CPU-second")).unwrap_or_default()
         ));
         per_thread.push(rate);
     }

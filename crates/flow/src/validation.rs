@@ -428,6 +428,7 @@ fn mass_balance(quick: bool) -> Vec<Check> {
         domain: Some(Aabb::new(Vec3::new(-1.0, -1.0, -0.5), Vec3::new(1.0, 1.0, 1.0))),
         dispersion: Some(Default::default()),
         max_bounces: 8,
+        resort_interval: 20,
     };
     let mut tr = Tracker::new(
         field,

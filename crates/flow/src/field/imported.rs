@@ -449,6 +449,38 @@ fn ls_weights(xp: Vec3, stencil: &[u32], centres: &[Vec3]) -> Option<Vec<f64>> {
     Some(rows.iter().map(|(a, w)| w * (a[0] * z[0] + a[1] * z[1] + a[2] * z[2] + a[3] * z[3])).collect())
 }
 
+impl ImportedField {
+    /// Point or cell-point interpolation in a steady field.
+    #[inline]
+    fn sample_steady(&self, loc: &super::tetmesh::Location, want_grad: bool) -> Sample {
+        let f = &self.frames[0];
+        let v = self.mesh.tets[loc.tet as usize];
+        let mut s = Sample::default();
+        for k in 0..4 {
+            s.u += loc.bary[k] * f.u[v[k] as usize];
+        }
+        if self.turbulence {
+            for k in 0..4 {
+                let p = v[k] as usize;
+                s.k += loc.bary[k] * f.k[p];
+                s.eps += loc.bary[k] * f.eps[p];
+            }
+        }
+        if want_grad {
+            let g = self.mesh.bary_gradients(loc.tet);
+            let mut m = Mat3::ZERO;
+            for k in 0..4 {
+                let uk = f.u[v[k] as usize];
+                m.x_axis += uk * g[k].x;
+                m.y_axis += uk * g[k].y;
+                m.z_axis += uk * g[k].z;
+            }
+            s.grad = m;
+        }
+        s
+    }
+}
+
 /// Gaussian elimination with partial pivoting; `None` when (nearly) singular.
 fn solve4(mut m: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
     let scale = (0..4).map(|i| m[i][i].abs()).fold(0.0, f64::max);
@@ -478,7 +510,13 @@ fn solve4(mut m: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
 impl FlowField for ImportedField {
     #[inline]
     fn sample(&self, x: Vec3, t: f64, hint: &mut u32, want_grad: bool) -> Option<Sample> {
-        let loc = self.mesh.locate(x, hint)?;
+        let loc = match self.mesh.locate(x, hint) {
+            Some(l) => l,
+            None => self.mesh.extrapolate(x, *hint)?,
+        };
+        if self.frames.len() == 1 && self.mode != Interpolation::Cell {
+            return Some(self.sample_steady(&loc, want_grad));
+        }
         let (i0, i1, w1, inv_dt) = self.bracket(t);
         let w0 = 1.0 - w1;
         let (f0, f1) = (&self.frames[i0], &self.frames[i1]);

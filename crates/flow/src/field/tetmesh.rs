@@ -23,6 +23,10 @@ pub const NONE: u32 = u32::MAX;
 /// Barycentric tolerance: a point is inside when every coordinate ≥ −`INSIDE_TOL`.
 pub const INSIDE_TOL: f64 = 1e-10;
 
+/// How far outside its last tetrahedron (in barycentric units) a point may be and still get values
+/// extrapolated from it ([`TetMesh::extrapolate`]).
+pub const EXTRAPOLATION_LIMIT: f64 = 0.25;
+
 /// Maximum number of walk steps before the bin grid is asked.
 const MAX_WALK: usize = 48;
 
@@ -224,6 +228,25 @@ impl TetMesh {
         let loc = self.locate_in_bins(x)?;
         *hint = loc.tet;
         Some(loc)
+    }
+
+    /// For a point just outside the mesh (a particle sliding along a wall whose CFD surface and STL
+    /// differ slightly, or leaving through an outlet): the location in tetrahedron `hint` with negative
+    /// barycentric coordinates clipped to zero (the nearest point of that tetrahedron's face, roughly),
+    /// provided no coordinate is below −[`EXTRAPOLATION_LIMIT`]; `None` otherwise.
+    #[inline]
+    pub fn extrapolate(&self, x: Vec3, hint: u32) -> Option<Location> {
+        if hint as usize >= self.tets.len() {
+            return None;
+        }
+        let mut l = self.barycentric(hint, x);
+        if l.iter().any(|&v| v < -EXTRAPOLATION_LIMIT) {
+            return None;
+        }
+        l.iter_mut().for_each(|v| *v = v.max(0.0));
+        let sum: f64 = l.iter().sum();
+        l.iter_mut().for_each(|v| *v /= sum);
+        Some(Location { tet: hint, bary: l })
     }
 
     /// Location through the bin grid only.

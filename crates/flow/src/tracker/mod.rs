@@ -54,13 +54,12 @@ pub enum Status {
     Escaped,
 }
 
-/// One parcel: `count` identical particles moving together.
+/// One parcel: `count` identical particles moving together. The state every step reads; what only
+/// some force models need lives in [`ParcelExtra`] and [`History`] side arrays.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Parcel {
     pub pos: Vec3,
     pub vel: Vec3,
-    /// Angular velocity \[rad/s\].
-    pub spin: Vec3,
     pub diameter: f64,
     pub density: f64,
     pub count: f64,
@@ -71,9 +70,16 @@ pub struct Parcel {
     pub status: Status,
     /// Injector that released it.
     pub injector: u16,
+}
+
+/// Per-parcel state kept only when the random walk or the particle spin is in use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParcelExtra {
+    /// Angular velocity \[rad/s\].
+    pub spin: Vec3,
     /// Current eddy of the random walk.
     pub eddy: Eddy,
-    /// Its own random stream.
+    /// The parcel's own random stream (`seeded(seed, id)`).
     pub rng: Rng,
 }
 
@@ -94,11 +100,14 @@ pub struct TrackSettings {
     pub dispersion: Option<DispersionSettings>,
     /// Maximum wall bounces handled within one step.
     pub max_bounces: u32,
+    /// Every this many steps the parcels are reordered by their location (cell order, which follows a
+    /// Morton curve), so that neighbouring parcels in memory read neighbouring mesh data; 0 = never.
+    pub resort_interval: u32,
 }
 
 impl Default for TrackSettings {
     fn default() -> Self {
-        TrackSettings { dt: 1e-4, domain: None, dispersion: None, max_bounces: 8 }
+        TrackSettings { dt: 1e-4, domain: None, dispersion: None, max_bounces: 8, resort_interval: 20 }
     }
 }
 
@@ -119,6 +128,8 @@ pub struct TrackerState {
     pub time: f64,
     pub step: u64,
     pub parcels: Vec<Parcel>,
+    /// Spin and random-walk state, one per parcel when dispersion, Magnus lift or the fluid torque is on.
+    pub extras: Vec<ParcelExtra>,
     /// Slip histories (Basset), one per parcel when the force is on.
     pub histories: Vec<History>,
     /// One per body.
@@ -204,7 +215,6 @@ impl<F: FlowField> Tracker<F> {
         let mut parcel = Parcel {
             pos: p.pos,
             vel: p.vel,
-            spin: Vec3::ZERO,
             diameter: p.diameter,
             density: p.density,
             count: p.count,
@@ -212,9 +222,14 @@ impl<F: FlowField> Tracker<F> {
             hint: NONE,
             status: Status::Airborne,
             injector,
-            eddy: Eddy::default(),
-            rng: seeded(seed, id),
         };
+        if self.needs_extras() {
+            self.state.extras.push(ParcelExtra {
+                spin: Vec3::ZERO,
+                eddy: Eddy::default(),
+                rng: seeded(seed, id),
+            });
+        }
         let m = parcel.mass();
         let b = &mut self.state.balance;
         b.injected.add(m);
@@ -239,8 +254,37 @@ impl<F: FlowField> Tracker<F> {
         self.state.parcels.push(parcel);
     }
 
+    /// Whether parcels carry a [`ParcelExtra`].
+    fn needs_extras(&self) -> bool {
+        let s = &self.model.switches;
+        self.settings.dispersion.is_some() || s.magnus || s.rotational_torque.is_some()
+    }
+
+    /// Reorders the parcels: airborne ones first, by location cell, then by id (deterministic).
+    pub fn sort_parcels(&mut self) {
+        let ps = &self.state.parcels;
+        let mut order: Vec<u32> = (0..ps.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| {
+            let p = &ps[i as usize];
+            (p.status != Status::Airborne, p.hint, p.id)
+        });
+        self.state.parcels = order.iter().map(|&i| ps[i as usize].clone()).collect();
+        if !self.state.histories.is_empty() {
+            let h = &self.state.histories;
+            self.state.histories = order.iter().map(|&i| h[i as usize].clone()).collect();
+        }
+        if !self.state.extras.is_empty() {
+            let e = &self.state.extras;
+            self.state.extras = order.iter().map(|&i| e[i as usize].clone()).collect();
+        }
+    }
+
     /// Advances every airborne parcel by one step.
     pub fn step(&mut self) -> Result<(), TrackError> {
+        let every = self.settings.resort_interval as u64;
+        if every > 0 && self.state.step % every == 0 && self.field.tet_hint_count() > 0 {
+            self.sort_parcels();
+        }
         let n_chunks = self.state.parcels.len().div_ceil(CHUNK);
         if self.events.len() < n_chunks {
             self.events.resize_with(n_chunks, Vec::new);
@@ -258,37 +302,60 @@ impl<F: FlowField> Tracker<F> {
         let step = self.state.step;
         let events = &mut self.events[..n_chunks];
         let errors = &mut self.errors[..n_chunks];
-        if self.state.histories.is_empty() {
-            self.state
-                .parcels
-                .par_chunks_mut(CHUNK)
-                .zip(events.par_iter_mut())
-                .zip(errors.par_iter_mut())
-                .for_each(|((chunk, ev), err)| {
-                    ev.clear();
-                    *err = None;
-                    for p in chunk.iter_mut() {
-                        if let Some(e) = advance(p, None, &ctx, ev, step) {
-                            err.get_or_insert(e);
-                        }
-                    }
-                });
-        } else {
-            self.state
-                .parcels
-                .par_chunks_mut(CHUNK)
-                .zip(self.state.histories.par_chunks_mut(CHUNK))
-                .zip(events.par_iter_mut())
-                .zip(errors.par_iter_mut())
-                .for_each(|(((chunk, hist), ev), err)| {
-                    ev.clear();
-                    *err = None;
-                    for (p, h) in chunk.iter_mut().zip(hist.iter_mut()) {
-                        if let Some(e) = advance(p, Some(h), &ctx, ev, step) {
-                            err.get_or_insert(e);
-                        }
-                    }
-                });
+        let st = &mut self.state;
+        // One loop per combination of side arrays (rayon's zip needs them all present).
+        macro_rules! chunks {
+            ($extras:expr, $hist:expr, $body:expr) => {
+                st.parcels
+                    .par_chunks_mut(CHUNK)
+                    .zip($extras)
+                    .zip($hist)
+                    .zip(events.par_iter_mut())
+                    .zip(errors.par_iter_mut())
+                    .for_each(|((((chunk, ex), hi), ev), err)| {
+                        ev.clear();
+                        *err = None;
+                        #[allow(clippy::redundant_closure_call)]
+                        ($body)(chunk, ex, hi, ev, err);
+                    })
+            };
+        }
+        fn run<F: FlowField>(
+            chunk: &mut [Parcel],
+            mut ex: Option<&mut [ParcelExtra]>,
+            mut hi: Option<&mut [History]>,
+            ev: &mut Vec<Event>,
+            err: &mut Option<TrackError>,
+            ctx: &Ctx<F>,
+            step: u64,
+        ) {
+            for (i, p) in chunk.iter_mut().enumerate() {
+                let e = ex.as_deref_mut().map(|x| &mut x[i]);
+                let h = hi.as_deref_mut().map(|x| &mut x[i]);
+                if let Some(x) = advance(p, e, h, ctx, ev, step) {
+                    err.get_or_insert(x);
+                }
+            }
+        }
+        let none_e = || (0..n_chunks).into_par_iter().map(|_| None::<&mut [ParcelExtra]>);
+        let none_h = || (0..n_chunks).into_par_iter().map(|_| None::<&mut [History]>);
+        match (st.extras.is_empty(), st.histories.is_empty()) {
+            (true, true) => chunks!(none_e(), none_h(), |c, e, h, v, r| run(c, e, h, v, r, &ctx, step)),
+            (false, true) => {
+                chunks!(st.extras.par_chunks_mut(CHUNK).map(Some), none_h(), |c, e, h, v, r| run(
+                    c, e, h, v, r, &ctx, step
+                ))
+            }
+            (true, false) => {
+                chunks!(none_e(), st.histories.par_chunks_mut(CHUNK).map(Some), |c, e, h, v, r| run(
+                    c, e, h, v, r, &ctx, step
+                ))
+            }
+            (false, false) => chunks!(
+                st.extras.par_chunks_mut(CHUNK).map(Some),
+                st.histories.par_chunks_mut(CHUNK).map(Some),
+                |c, e, h, v, r| run(c, e, h, v, r, &ctx, step)
+            ),
         }
         if let Some(e) = self.errors[..n_chunks].iter_mut().find_map(|e| e.take()) {
             return Err(e);
@@ -368,6 +435,7 @@ fn first_hit(bodies: &[Body], a: Vec3, b: Vec3) -> Option<(f64, usize, u32)> {
 #[inline]
 fn advance<F: FlowField>(
     p: &mut Parcel,
+    mut extra: Option<&mut ParcelExtra>,
     hist: Option<&mut History>,
     ctx: &Ctx<F>,
     events: &mut Vec<Event>,
@@ -385,13 +453,14 @@ fn advance<F: FlowField>(
     let model = ctx.model;
     let (d, rho) = (p.diameter, p.density);
     let mut u = s.u;
-    if let Some(disp) = &ctx.s.dispersion {
+    if let (Some(disp), Some(x)) = (&ctx.s.dispersion, extra.as_deref_mut()) {
         let slip = (s.u - p.vel).length();
         let tau = model.switches.drag.relaxation_time(&model.fluid, d, rho, slip);
-        u += disp.fluctuation(&mut p.eddy, &mut p.rng, s.k, s.eps, tau, slip, dt);
+        u += disp.fluctuation(&mut x.eddy, &mut x.rng, s.k, s.eps, tau, slip, dt);
     }
     let fl = FluidLocal { u, grad: s.grad, du_dt: s.du_dt };
-    let f = model.evaluate(d, rho, p.vel, p.spin, &fl);
+    let spin = extra.as_deref().map(|x| x.spin).unwrap_or(Vec3::ZERO);
+    let f = model.evaluate(d, rho, p.vel, spin, &fl);
     let mut inertia = f.inertia;
     let mut a = f.accel;
     if let (Some(h), Some(bs)) = (hist, model.switches.basset) {
@@ -411,10 +480,10 @@ fn advance<F: FlowField>(
         let (x1, v1) = exponential_update(p.pos, p.vel, u, tau, a / inertia, dt);
         h.push(u - v1, dt);
         h.u_last = u;
-        return finish(p, x1, v1, f.spin_accel, &fl, ctx, events, step);
+        return finish(p, extra, x1, v1, f.spin_accel, &fl, ctx, events, step);
     }
     let (x1, v1) = exponential_update(p.pos, p.vel, u, f.tau * inertia, a / inertia, dt);
-    finish(p, x1, v1, f.spin_accel, &fl, ctx, events, step)
+    finish(p, extra, x1, v1, f.spin_accel, &fl, ctx, events, step)
 }
 
 /// Spin update, wall hits and domain exit after the free-flight update to (x1, v1).
@@ -422,6 +491,7 @@ fn advance<F: FlowField>(
 #[inline]
 fn finish<F: FlowField>(
     p: &mut Parcel,
+    extra: Option<&mut ParcelExtra>,
     x1: Vec3,
     v1: Vec3,
     spin_accel: Vec3,
@@ -431,13 +501,13 @@ fn finish<F: FlowField>(
     step: u64,
 ) -> Option<TrackError> {
     let dt = ctx.dt;
-    if ctx.model.switches.rotational_torque.is_some() {
+    if let (Some(_), Some(x)) = (ctx.model.switches.rotational_torque, extra) {
         let half_omega = 0.5 * fl.vorticity();
-        let rel = p.spin - half_omega;
+        let rel = x.spin - half_omega;
         let r = rel.length();
         if r > 0.0 {
             let rate = spin_accel.length() / r;
-            p.spin = half_omega + rel * (-rate * dt).exp();
+            x.spin = half_omega + rel * (-rate * dt).exp();
         }
     }
     let (x0, v0) = (p.pos, p.vel);

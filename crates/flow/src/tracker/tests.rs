@@ -249,6 +249,7 @@ fn busy_run(threads: usize) -> (TrackerState, (f64, f64)) {
             domain: Some(Aabb::new(Vec3::new(-1.0, -1.0, -0.5), Vec3::new(1.0, 1.0, 1.0))),
             dispersion: Some(DispersionSettings { seed: 42, ..Default::default() }),
             max_bounces: 8,
+            resort_interval: 20,
         };
         let mut tr = Tracker::new(
             field,
@@ -289,6 +290,8 @@ fn results_do_not_depend_on_thread_count_and_mass_balance_is_exact() {
     let (a, bal_a) = busy_run(1);
     let (b, bal_b) = busy_run(2);
     assert_eq!(a.parcels, b.parcels, "parcel states differ between 1 and 2 threads");
+    assert!(!a.extras.is_empty());
+    assert_eq!(a.extras, b.extras, "random-walk states differ between 1 and 2 threads");
     assert_eq!(a.deposits, b.deposits);
     assert_eq!(bal_a.0.to_bits(), bal_b.0.to_bits());
     // Every category happened.

@@ -160,6 +160,7 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
         domain: cfg.domain.map(|d| Aabb::new(d.min_m, d.max_m)),
         dispersion: cfg.dispersion,
         max_bounces: 8,
+        resort_interval: 20,
     };
     if cfg.dispersion.is_some() && !field.has_turbulence() {
         tracing::warn!("dispersion is on but the flow field has no k and ε: the random walk does nothing");
