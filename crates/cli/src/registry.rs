@@ -8,12 +8,14 @@ pub const DEMO_SCENARIO: (&str, &str) =
     ("examples/snow_regime_map.toml", include_str!("../../../examples/snow_regime_map.toml"));
 
 /// Names accepted by `spatter bench`.
-pub const BENCHES: &[&str] = &["snow"];
+pub const BENCHES: &[&str] = &["snow", "track"];
 
 /// Every registered validation case, engine by engine.
 pub fn validation_cases() -> Vec<Case> {
     let mut cases = spatter_dem::validation_cases();
     cases.extend(spatter_workflows::snow::validation_cases());
+    cases.extend(spatter_flow::validation::validation_cases());
+    cases.extend(spatter_sph::validation::validation_cases());
     cases
 }
 
@@ -21,6 +23,7 @@ pub fn validation_cases() -> Vec<Case> {
 pub fn run_bench(name: &str, quick: bool) -> anyhow::Result<Vec<String>> {
     match name {
         "snow" => Ok(spatter_workflows::snow::bench(quick)?),
+        "track" => Ok(spatter_flow::bench::bench(quick)?),
         _ => anyhow::bail!("no benchmark named `{name}`; expected one of: {}", BENCHES.join(", ")),
     }
 }
