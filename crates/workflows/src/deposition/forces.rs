@@ -26,12 +26,11 @@ pub fn rankings(cfg: &ForcesConfig) -> (Ranking, Ranking) {
     (reference_terms(&input), physical_magnitudes(&input))
 }
 
+/// A diameter for a column header: "10 µm", "2.5 µm", "1.5 mm".
 fn fmt_d(d: f64) -> String {
-    if d < 1e-3 {
-        format!("{:.4} µm", d * 1e6)
-    } else {
-        format!("{:.4} mm", d * 1e3)
-    }
+    let (v, unit) = if d < 1e-3 { (d * 1e6, "µm") } else { (d * 1e3, "mm") };
+    let s = format!("{v:.3}");
+    format!("{} {unit}", s.trim_end_matches('0').trim_end_matches('.'))
 }
 
 /// A ranking as screen lines: one row per force, one column per diameter.
@@ -39,7 +38,7 @@ pub fn format_table(title: &str, r: &Ranking) -> Vec<String> {
     let mut out = vec![title.to_owned()];
     let mut head = format!("{:<10} {:<38} {:>3}", "symbol", "force", "dir");
     for d in &r.diameters {
-        head += &format!(" {:>12}", fmt_d(*d).trim_end_matches(".0000 µm").to_owned());
+        head += &format!(" {:>12}", fmt_d(*d));
     }
     out.push(head);
     let mut re = format!("{:<10} {:<38} {:>3}", "Re_0", "particle Reynolds number at u_0", "");
