@@ -3,6 +3,7 @@
 pub mod adhesion;
 pub mod restitution_models;
 
+pub mod bench;
 pub mod contact;
 pub mod error;
 pub mod insertion;

@@ -50,6 +50,7 @@ where
 {
     type Params = ComposedParams<N::Params, D::Params, T::Params, R::Params>;
     type State = ComposedState<N::State, D::State, T::State, R::State>;
+    const USES_ROTATION: bool = R::USES_ROTATION;
 
     fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params {
         ComposedParams {
@@ -60,12 +61,12 @@ where
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn range(&self, p: &Self::Params, r_eff: f64) -> f64 {
         self.normal.range(&p.normal, r_eff)
     }
 
-    #[inline]
+    #[inline(always)]
     fn compute(&self, p: &Self::Params, c: &ContactInput, s: &mut Self::State) -> Option<ContactOutput> {
         let nf = self.normal.evaluate(&p.normal, c, &mut s.normal)?;
         if !s.formed {
@@ -82,20 +83,20 @@ where
                 f_n = floor;
             }
         }
-        // Power absorbed by the normal dashpot: −F_d·v_n ≥ 0.
-        let mut dissipation = -(f_n - nf.force) * vn;
+        // Work absorbed by the normal dashpot in this step: −F_d·v_n Δt ≥ 0.
+        let mut dissipated = -(f_n - nf.force) * vn * c.dt;
         let f_coulomb = nf.coulomb_force.unwrap_or(f_n.max(0.0));
         let v_t = c.v_rel - vn * n;
         let k_t = self.tangential.stiffness(&p.tangential, &nf, c);
         let gamma_t = self.damping.tangential_coefficient(&p.damping, &s.damping, k_t, c);
         let t = self.tangential.force(&p.tangential, &mut s.tangential, k_t, gamma_t, f_coulomb, v_t, c);
         let (rolling_torque, roll_diss) = self.rolling.torque(&p.rolling, &mut s.rolling, f_coulomb, c);
-        dissipation += t.dissipation + roll_diss;
+        dissipated += t.dissipated + roll_diss * c.dt;
         Some(ContactOutput {
             force: f_n * n + t.force,
             normal_force: f_n,
             rolling_torque,
-            dissipation,
+            dissipated,
             energy: nf.energy + t.energy,
         })
     }

@@ -106,7 +106,7 @@ impl DampingLaw for RestitutionDamping {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn normal_coefficient(
         &self,
         p: &RestitutionDampingParams,
@@ -117,7 +117,7 @@ impl DampingLaw for RestitutionDamping {
         p.c_n * (c.m_eff * nf.damping_stiffness).sqrt()
     }
 
-    #[inline]
+    #[inline(always)]
     fn tangential_coefficient(
         &self,
         p: &RestitutionDampingParams,
@@ -128,7 +128,7 @@ impl DampingLaw for RestitutionDamping {
         p.c_t * (c.m_eff * k_t).sqrt()
     }
 
-    #[inline]
+    #[inline(always)]
     fn tensile_clamp(&self, p: &RestitutionDampingParams) -> bool {
         p.clamp
     }
@@ -144,12 +144,12 @@ impl DampingLaw for NoDamping {
 
     fn params(&self, _pair_index: usize, _props: &PairProps, _p: f64) {}
 
-    #[inline]
+    #[inline(always)]
     fn normal_coefficient(&self, _p: &(), _s: &(), _nf: &NormalForce, _c: &ContactInput) -> f64 {
         0.0
     }
 
-    #[inline]
+    #[inline(always)]
     fn tangential_coefficient(&self, _p: &(), _s: &(), _k_t: f64, _c: &ContactInput) -> f64 {
         0.0
     }

@@ -92,7 +92,7 @@ use spatter_core::Vec3;
 use std::fmt::Debug;
 
 /// Geometry and kinematics of one contact, seen from particle i.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactInput {
     /// Unit normal pointing from the partner to particle i.
     pub normal: Vec3,
@@ -121,8 +121,9 @@ pub struct ContactOutput {
     pub normal_force: f64,
     /// Rolling-resistance torque on particle i \[N m\] (not including the torque of the tangential force).
     pub rolling_torque: Vec3,
-    /// Rate of energy dissipation in this contact \[W\] (dashpots, Coulomb slip, rolling), ≥ 0.
-    pub dissipation: f64,
+    /// Energy dissipated in this contact during this step \[J\] (dashpots, Coulomb slip, rolling, and the
+    /// stored-energy change of a tangential spring whose stiffness follows the normal load).
+    pub dissipated: f64,
     /// Elastic energy stored in the contact \[J\] (normal and tangential springs).
     pub energy: f64,
 }
@@ -143,6 +144,10 @@ pub trait ContactLaw: Clone + Send + Sync + 'static {
     type Params: Clone + Debug + Send + Sync;
     /// Per-contact persistent state; `Default` means "no contact".
     type State: Copy + Default + PartialEq + Debug + Send + Sync + Serialize + DeserializeOwned;
+
+    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`] (rolling resistance). When
+    /// false the engine may leave them zero and skip computing them.
+    const USES_ROTATION: bool = true;
 
     /// Precomputes the parameters of pair type `pair_index` (index into the engine's pair table).
     fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params;

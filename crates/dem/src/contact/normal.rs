@@ -74,7 +74,7 @@ pub struct HookeParams {
 
 impl Hooke {
     /// k_n \[N/m\] of a contact.
-    #[inline]
+    #[inline(always)]
     pub fn stiffness(p: &HookeParams, r_eff: f64, m_eff: f64) -> f64 {
         match p.stiffness {
             HookeStiffness::Constant(k) => k,
@@ -94,7 +94,7 @@ impl NormalLaw for Hooke {
         HookeParams { e_star: props.e_star, stiffness: self.stiffness }
     }
 
-    #[inline]
+    #[inline(always)]
     fn evaluate(&self, p: &HookeParams, c: &ContactInput, _s: &mut ()) -> Option<NormalForce> {
         let d = c.overlap;
         if d <= 0.0 {
@@ -137,7 +137,7 @@ impl NormalLaw for Hertz {
         HertzParams { e_star: props.e_star }
     }
 
-    #[inline]
+    #[inline(always)]
     fn evaluate(&self, p: &HertzParams, c: &ContactInput, _s: &mut ()) -> Option<NormalForce> {
         let d = c.overlap;
         if d <= 0.0 {

@@ -77,13 +77,13 @@ impl<P: Clone> PairTable<P> {
     }
 
     /// Value of pair (a, b).
-    #[inline]
+    #[inline(always)]
     pub fn get(&self, a: usize, b: usize) -> &P {
         &self.items[a * self.n + b]
     }
 
     /// The pair index of (a, b) (same for (b, a)): `min·n + max`.
-    #[inline]
+    #[inline(always)]
     pub fn index(&self, a: usize, b: usize) -> usize {
         let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
         lo * self.n + hi

@@ -20,6 +20,9 @@ pub trait RollingLaw: Clone + Debug + Send + Sync + 'static {
     type Params: Clone + Debug + Send + Sync;
     type State: Copy + Default + PartialEq + Debug + Send + Sync + Serialize + DeserializeOwned;
 
+    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`].
+    const USES_ROTATION: bool = true;
+
     fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params;
 
     /// Torque on particle i \[N m\] and dissipation rate \[W\], for the normal force `f_n` ≥ 0 \[N\] that caps
@@ -27,14 +30,14 @@ pub trait RollingLaw: Clone + Debug + Send + Sync + 'static {
     fn torque(&self, p: &Self::Params, state: &mut Self::State, f_n: f64, c: &ContactInput) -> (Vec3, f64);
 }
 
-#[inline]
+#[inline(always)]
 fn rolling_rotation(c: &ContactInput) -> Vec3 {
     c.w_rel - c.w_rel.dot(c.normal) * c.normal
 }
 
 /// Applies the no-reversal limit and returns (torque, dissipation) for a torque of magnitude `m`
 /// opposing `w_roll`.
-#[inline]
+#[inline(always)]
 fn opposing(m: f64, w_roll: Vec3, c: &ContactInput) -> (Vec3, f64) {
     let w = w_roll.length();
     if w == 0.0 || m <= 0.0 {
@@ -58,7 +61,7 @@ impl RollingLaw for ConstantTorque {
         props.rolling_friction
     }
 
-    #[inline]
+    #[inline(always)]
     fn torque(&self, mu_r: &f64, _s: &mut (), f_n: f64, c: &ContactInput) -> (Vec3, f64) {
         opposing(mu_r * c.r_eff * f_n.max(0.0), rolling_rotation(c), c)
     }
@@ -77,7 +80,7 @@ impl RollingLaw for ViscousRolling {
         props.rolling_viscous
     }
 
-    #[inline]
+    #[inline(always)]
     fn torque(&self, mu_rv: &f64, _s: &mut (), f_n: f64, c: &ContactInput) -> (Vec3, f64) {
         let w = rolling_rotation(c);
         opposing(mu_rv * c.r_eff * c.r_eff * f_n.max(0.0) * w.length(), w, c)
@@ -91,10 +94,11 @@ pub struct NoRolling;
 impl RollingLaw for NoRolling {
     type Params = ();
     type State = ();
+    const USES_ROTATION: bool = false;
 
     fn params(&self, _pair_index: usize, _props: &PairProps) {}
 
-    #[inline]
+    #[inline(always)]
     fn torque(&self, _p: &(), _s: &mut (), _f_n: f64, _c: &ContactInput) -> (Vec3, f64) {
         (Vec3::ZERO, 0.0)
     }
@@ -119,7 +123,7 @@ impl RollingLaw for AnyRolling {
         (props.rolling_friction, props.rolling_viscous)
     }
 
-    #[inline]
+    #[inline(always)]
     fn torque(&self, p: &(f64, f64), s: &mut (), f_n: f64, c: &ContactInput) -> (Vec3, f64) {
         match self {
             AnyRolling::None => (Vec3::ZERO, 0.0),

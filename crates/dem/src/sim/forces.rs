@@ -16,10 +16,8 @@ pub struct SlotOut {
     pub active: bool,
     /// The contact formed in the last evaluation.
     pub formed: bool,
-    /// |F_n| \[N\].
+    /// Signed normal force F_n \[N\] (the tangential magnitude is √(|F|² − F_n²)).
     pub normal_force: f64,
-    /// |F_t| \[N\].
-    pub tangential_force: f64,
     /// Normal approach speed −v_rel·n \[m/s\].
     pub approach_speed: f64,
     /// Contact force on the particle \[N\] (the wall gets the opposite).
@@ -29,7 +27,7 @@ pub struct SlotOut {
 /// Per-task reduction of one evaluation.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Acc {
-    pub dissipation: f64,
+    pub dissipated: f64,
     pub elastic: f64,
     pub wall_power: f64,
     pub pair_contacts: u64,
@@ -44,7 +42,7 @@ impl Acc {
         let (max_ratio, worst) =
             if b.max_ratio > a.max_ratio { (b.max_ratio, b.worst) } else { (a.max_ratio, a.worst) };
         Acc {
-            dissipation: a.dissipation + b.dissipation,
+            dissipated: a.dissipated + b.dissipated,
             elastic: a.elastic + b.elastic,
             wall_power: a.wall_power + b.wall_power,
             pair_contacts: a.pair_contacts + b.pair_contacts,
@@ -74,20 +72,26 @@ impl<L: ContactLaw> Simulation<L> {
         let g = self.gravity;
         let n = self.particles.len();
 
-        // Gravity and persistent external forces.
-        {
+        // Gravity and persistent external forces (already set by the drift pass under velocity Verlet).
+        if !std::mem::take(&mut self.base_forces_ready) {
             let p = &mut self.particles;
             let has_ext = !p.ext_force.is_empty();
             let (ext_f, ext_t) = (&p.ext_force, &p.ext_torque);
-            p.force.par_iter_mut().zip(p.torque.par_iter_mut()).enumerate().for_each(|(i, (f, tq))| {
-                let m = p.mass[i];
-                *f = if p.inv_mass[i] > 0.0 { m * g } else { Vec3::ZERO };
-                *tq = Vec3::ZERO;
-                if has_ext {
-                    *f += ext_f[i];
-                    *tq += ext_t[i];
-                }
-            });
+            const CHUNK: usize = 4096;
+            let (mass, inv_mass) = (&p.mass, &p.inv_mass);
+            p.force.par_chunks_mut(CHUNK).zip(p.torque.par_chunks_mut(CHUNK)).enumerate().for_each(
+                |(c, (fs, ts))| {
+                    for (k, (f, tq)) in fs.iter_mut().zip(ts.iter_mut()).enumerate() {
+                        let i = c * CHUNK + k;
+                        *f = if inv_mass[i] > 0.0 { mass[i] * g } else { Vec3::ZERO };
+                        *tq = Vec3::ZERO;
+                        if has_ext {
+                            *f += ext_f[i];
+                            *tq += ext_t[i];
+                        }
+                    }
+                },
+            );
         }
         // External work uses the velocities at evaluation time (half-step velocities under Verlet).
         let mut ext_power = 0.0;
@@ -194,7 +198,7 @@ impl<L: ContactLaw> Simulation<L> {
                                 }
                                 Some(o) => {
                                     apply_wall(&o, n, r, i - pbase, f, tq);
-                                    acc.dissipation += o.dissipation;
+                                    acc.dissipated += o.dissipated;
                                     acc.elastic += o.energy;
                                     acc.wall_power += o.force.dot(v_wall) + o.rolling_torque.dot(kw.omega);
                                     acc.wall_contacts += 1;
@@ -202,8 +206,7 @@ impl<L: ContactLaw> Simulation<L> {
                                     *out = SlotOut {
                                         active: true,
                                         formed: was_new,
-                                        normal_force: o.normal_force.abs(),
-                                        tangential_force: o.tangential_force(n).length(),
+                                        normal_force: o.normal_force,
                                         approach_speed: -c.v_rel.dot(n),
                                         force: o.force,
                                     };
@@ -300,57 +303,97 @@ impl<L: ContactLaw> Simulation<L> {
             }
             m
         };
+        // Two stages per particle i: first the geometry of all its touching neighbours (short, independent
+        // iterations whose square roots and divisions overlap in the CPU), then the contact law for each.
+        const BUF: usize = 16;
+        #[derive(Clone, Copy, Default)]
+        struct Candidate {
+            k: usize,
+            a: usize,
+            b: usize,
+            c: ContactInput,
+        }
         let pair_work = |g: &Group,
                          pbase: usize,
                          (f, tq): (&mut [Vec3], &mut [Vec3]),
                          sbase: usize,
                          states: &mut [L::State]| {
             let mut acc = Acc::default();
+            let mut buf = [Candidate::default(); BUF];
             for i in g.work_begin as usize..g.work_end as usize {
-                for k in l_start[i] as usize..l_start[i + 1] as usize {
-                    let j = l_nbr[k] as usize;
-                    let state = &mut states[k - sbase];
-                    // Orientation by id keeps each state in the lower-id particle's frame.
-                    let (a, b) = if id[i] < id[j] { (i, j) } else { (j, i) };
-                    let d = pos[a] - pos[b];
-                    let (ra, rb) = (radius[a], radius[b]);
-                    let rs = ra + rb;
-                    let reach = rs + range_quick;
-                    let dist2 = d.length_squared();
-                    if dist2 >= reach * reach {
-                        if *state != default {
-                            *state = default;
+                let (mut k, k1) = (l_start[i] as usize, l_start[i + 1] as usize);
+                while k < k1 {
+                    let mut nbuf = 0;
+                    while k < k1 && nbuf < BUF {
+                        let j = l_nbr[k] as usize;
+                        // Orientation by id keeps each state in the lower-id particle's frame
+                        // (branch-free: the order of ids within a sorted list is random).
+                        let swap = (id[j] < id[i]) as usize;
+                        let a = i ^ ((i ^ j) & swap.wrapping_neg());
+                        let b = i ^ j ^ a;
+                        let d = pos[a] - pos[b];
+                        let (ra, rb) = (radius[a], radius[b]);
+                        let rs = ra + rb;
+                        let reach = rs + range_quick;
+                        let dist2 = d.length_squared();
+                        if dist2 >= reach * reach {
+                            let state = &mut states[k - sbase];
+                            if *state != default {
+                                *state = default;
+                            }
+                            k += 1;
+                            continue;
                         }
-                        continue;
+                        let dist = dist2.sqrt();
+                        let n = if dist > 0.0 { d * (1.0 / dist) } else { Vec3::Z };
+                        // One division for both R* = ra rb/(ra + rb) and m* = 1/(1/ma + 1/mb).
+                        let inv = inv_mass[a] + inv_mass[b];
+                        let q = 1.0 / (rs * inv);
+                        let (i_eff, w_rel) = if L::USES_ROTATION {
+                            (1.0 / (inv_inertia[a] + inv_inertia[b]), omega[a] - omega[b])
+                        } else {
+                            (0.0, Vec3::ZERO)
+                        };
+                        buf[nbuf] = Candidate {
+                            k,
+                            a,
+                            b,
+                            c: ContactInput {
+                                normal: n,
+                                overlap: rs - dist,
+                                r_eff: ra * rb * inv * q,
+                                m_eff: rs * q,
+                                i_eff,
+                                v_rel: vel[a] - vel[b] - (ra * omega[a] + rb * omega[b]).cross(n),
+                                w_rel,
+                                dt,
+                            },
+                        };
+                        nbuf += 1;
+                        k += 1;
                     }
-                    let dist = dist2.sqrt();
-                    let n = if dist > 0.0 { d / dist } else { Vec3::Z };
-                    let inv = inv_mass[a] + inv_mass[b];
-                    let inv_i = inv_inertia[a] + inv_inertia[b];
-                    let c = ContactInput {
-                        normal: n,
-                        overlap: rs - dist,
-                        r_eff: ra * rb / rs,
-                        m_eff: 1.0 / inv,
-                        i_eff: 1.0 / inv_i,
-                        v_rel: vel[a] - vel[b] - (ra * omega[a] + rb * omega[b]).cross(n),
-                        w_rel: omega[a] - omega[b],
-                        dt,
-                    };
-                    let pp = params.get(material[a] as usize, material[b] as usize);
-                    match law.compute(pp, &c, state) {
-                        None => *state = default,
-                        Some(o) => {
-                            let fv = o.force;
-                            let cr = n.cross(fv);
-                            f[a - pbase] += fv;
-                            f[b - pbase] -= fv;
-                            tq[a - pbase] += o.rolling_torque - ra * cr;
-                            tq[b - pbase] += -o.rolling_torque - rb * cr;
-                            acc.dissipation += o.dissipation;
-                            acc.elastic += o.energy;
-                            acc.pair_contacts += 1;
-                            acc.note_overlap(c.overlap / ra.min(rb), id[a], id[b]);
+                    for cand in &buf[..nbuf] {
+                        let (a, b, c) = (cand.a, cand.b, &cand.c);
+                        let state = &mut states[cand.k - sbase];
+                        let pp = params.get(material[a] as usize, material[b] as usize);
+                        match law.compute(pp, c, state) {
+                            None => *state = default,
+                            Some(o) => {
+                                let (ra, rb) = (radius[a], radius[b]);
+                                let fv = o.force;
+                                let cr = c.normal.cross(fv);
+                                f[a - pbase] += fv;
+                                f[b - pbase] -= fv;
+                                tq[a - pbase] += o.rolling_torque - ra * cr;
+                                tq[b - pbase] += -o.rolling_torque - rb * cr;
+                                acc.dissipated += o.dissipated;
+                                acc.elastic += o.energy;
+                                acc.pair_contacts += 1;
+                                let rmin = ra.min(rb);
+                                if c.overlap > acc.max_ratio * rmin {
+                                    acc.note_overlap(c.overlap / rmin, id[a], id[b]);
+                                }
+                            }
                         }
                     }
                 }
@@ -383,8 +426,9 @@ impl<L: ContactLaw> Simulation<L> {
             if let WallShape::Mesh(m) = &mut self.walls[wl.wall[k] as usize].shape {
                 let t = wl.tri[k] as usize;
                 let r = &mut m.records;
-                r.normal_impulse[t] += o.normal_force * dt;
-                r.tangential_impulse[t] += o.tangential_force * dt;
+                let ft = (o.force.length_squared() - o.normal_force * o.normal_force).max(0.0).sqrt();
+                r.normal_impulse[t] += o.normal_force.abs() * dt;
+                r.tangential_impulse[t] += ft * dt;
                 if o.formed {
                     r.impacts[t] += 1;
                     r.impact_speed_sum[t] += o.approach_speed;
@@ -393,7 +437,7 @@ impl<L: ContactLaw> Simulation<L> {
         }
 
         let e = &mut self.st.energy;
-        e.dissipated += acc.dissipation * dt;
+        e.dissipated += acc.dissipated;
         e.wall_work += acc.wall_power * dt;
         e.external_work += ext_power * dt;
         self.st.last = super::LastEvaluation {

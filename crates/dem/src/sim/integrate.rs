@@ -6,6 +6,7 @@ use crate::error::DemError;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spatter_core::math::is_finite;
+use spatter_core::Vec3;
 
 /// Time integration scheme.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -22,27 +23,50 @@ impl<L: ContactLaw> Simulation<L> {
     /// Kicks velocities by `frac`·Δt·F/m (and ω by `frac`·Δt·τ/I); with `drift`, then moves positions by
     /// v·Δt. Frozen particles keep their velocity and move with it. Returns the largest speed after the
     /// kick (for the neighbour-list displacement bound).
-    pub(crate) fn kick_drift(&mut self, frac: f64, drift: bool) -> f64 {
+    /// With `reset`, the force and torque arrays are then set to gravity (and the persistent external
+    /// forces) for the next evaluation, in the same pass.
+    pub(crate) fn kick_drift(&mut self, frac: f64, drift: bool, reset: bool) -> f64 {
         let h = frac * self.dt;
         let dt = self.dt;
+        let g = self.gravity;
         let p = &mut self.particles;
-        let (force, torque, inv_m, inv_i) = (&p.force, &p.torque, &p.inv_mass, &p.inv_inertia);
-        p.vel
-            .par_iter_mut()
-            .zip(p.omega.par_iter_mut())
-            .zip(p.pos.par_iter_mut())
+        let (inv_m, inv_i, mass) = (&p.inv_mass, &p.inv_inertia, &p.mass);
+        let (ext_f, ext_t) = (&p.ext_force, &p.ext_torque);
+        let has_ext = !ext_f.is_empty();
+        const CHUNK: usize = 4096;
+        let v2max = p
+            .vel
+            .par_chunks_mut(CHUNK)
+            .zip(p.omega.par_chunks_mut(CHUNK))
+            .zip(p.pos.par_chunks_mut(CHUNK))
+            .zip(p.force.par_chunks_mut(CHUNK).zip(p.torque.par_chunks_mut(CHUNK)))
             .enumerate()
-            .map(|(i, ((v, w), x))| {
-                if inv_m[i] > 0.0 {
-                    *v += h * inv_m[i] * force[i];
-                    *w += h * inv_i[i] * torque[i];
+            .map(|(c, (((vs, ws), xs), (fs, ts)))| {
+                let base = c * CHUNK;
+                let mut m: f64 = 0.0;
+                for (k, ((v, w), x)) in vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut()).enumerate() {
+                    let i = base + k;
+                    // Frozen particles have zero inverse mass and inertia: the kick vanishes.
+                    *v += (h * inv_m[i]) * fs[k];
+                    *w += (h * inv_i[i]) * ts[k];
+                    if drift {
+                        *x += *v * dt;
+                    }
+                    m = m.max(v.length_squared());
+                    if reset {
+                        fs[k] = if inv_m[i] > 0.0 { mass[i] * g } else { Vec3::ZERO };
+                        ts[k] = Vec3::ZERO;
+                        if has_ext {
+                            fs[k] += ext_f[i];
+                            ts[k] += ext_t[i];
+                        }
+                    }
                 }
-                if drift {
-                    *x += *v * dt;
-                }
-                v.length()
+                m
             })
-            .reduce(|| 0.0, f64::max)
+            .reduce(|| 0.0, f64::max);
+        self.base_forces_ready = reset;
+        v2max.sqrt()
     }
 
     /// Fails with a blow-up error naming the first particle whose state is not finite.

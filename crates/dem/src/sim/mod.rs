@@ -223,6 +223,8 @@ pub struct Simulation<L: ContactLaw> {
     external: Option<Box<dyn ExternalForces>>,
     /// Ids of the pair with the largest overlap in the last evaluation (second = `u32::MAX` for a wall).
     last_worst: (u32, u32),
+    /// The force arrays already hold gravity and external forces for the next evaluation.
+    base_forces_ready: bool,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -251,6 +253,7 @@ impl<L: ContactLaw> Simulation<L> {
             scratch: Scratch::default(),
             external: None,
             last_worst: (0, 0),
+            base_forces_ready: false,
         }
     }
 
@@ -420,18 +423,18 @@ impl<L: ContactLaw> Simulation<L> {
                 if !self.st.forces_valid {
                     self.evaluate()?;
                 }
-                let vmax = self.kick_drift(0.5, true);
+                let vmax = self.kick_drift(0.5, true, true);
                 self.advance_time(vmax);
                 self.maybe_rebuild();
                 self.evaluate()?;
-                self.kick_drift(0.5, false);
+                self.kick_drift(0.5, false, false);
             }
             Integrator::SymplecticEuler => {
                 if self.st.needs_rebuild {
                     self.rebuild();
                 }
                 self.evaluate()?;
-                let vmax = self.kick_drift(1.0, true);
+                let vmax = self.kick_drift(1.0, true, false);
                 self.advance_time(vmax);
                 self.maybe_rebuild();
                 // Forces now belong to the previous positions.

@@ -61,11 +61,13 @@ pub struct WallKinematics {
     pub v_center: Vec3,
     /// Angular velocity \[rad/s\].
     pub omega: Vec3,
+    /// The wall never moves (identity pose, zero velocity): the transforms are skipped.
+    pub fixed: bool,
 }
 
 impl WallKinematics {
     pub const FIXED: WallKinematics =
-        WallKinematics { pose: Pose::IDENTITY, v_center: Vec3::ZERO, omega: Vec3::ZERO };
+        WallKinematics { pose: Pose::IDENTITY, v_center: Vec3::ZERO, omega: Vec3::ZERO, fixed: true };
 
     /// Kinematics of `motion` at time `t` \[s\].
     pub fn of(motion: &Motion, t: f64) -> Self {
@@ -77,24 +79,34 @@ impl WallKinematics {
             pose,
             v_center: motion.velocity_at(t, pose.center()),
             omega: motion.angular_velocity(t),
+            fixed: false,
         }
     }
 
     /// Velocity of the wall's material point at world position `x` \[m/s\].
     #[inline]
     pub fn velocity_at(&self, x: Vec3) -> Vec3 {
+        if self.fixed {
+            return Vec3::ZERO;
+        }
         self.v_center + self.omega.cross(x - self.pose.center())
     }
 
     /// Maps a world point into the wall's reference frame.
     #[inline]
     pub fn to_reference(&self, x: Vec3) -> Vec3 {
+        if self.fixed {
+            return x;
+        }
         self.pose.inverse_apply(x)
     }
 
     /// Maps a reference-frame hit to world coordinates.
     #[inline]
     pub fn hit_to_world(&self, point_ref: Vec3, normal_ref: Vec3, distance: f64) -> WallHit {
+        if self.fixed {
+            return WallHit { point: point_ref, normal: normal_ref, distance };
+        }
         WallHit { point: self.pose.apply(point_ref), normal: self.pose.rotation * normal_ref, distance }
     }
 
@@ -119,7 +131,7 @@ impl Wall {
 
     /// The contact of a sphere at reference-frame position `x` with an analytic wall, if the surface is
     /// closer than `reach` \[m\] (meshes are handled by [`MeshWall::resolve`]).
-    #[inline]
+    #[inline(always)]
     pub fn analytic_hit(&self, x: Vec3, reach: f64) -> Option<(Vec3, Vec3, f64)> {
         match &self.shape {
             WallShape::Plane(p) => p.hit(x, reach),

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Runs the DEM benchmark box in spatter and in LAMMPS on this machine and prints the ratio.
+#
+#   bench/dem/compare.sh            # full case: 102,400 spheres, 1000 timed steps
+#   QUICK=1 STEPS=200 bench/dem/compare.sh
+#
+# Needs `lmp` (Debian package `lammps`, GRANULAR package included) and cargo. Measure on a quiet
+# machine: the load average is printed first.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+steps="${STEPS:-1000}"
+quick="${QUICK:+--quick}"
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
+
+echo "load: $(uptime)"
+command -v lmp >/dev/null || { echo "lmp not found: apt-get install -y lammps" >&2; exit 1; }
+(cd "$root" && cargo build --quiet --release -p spatter-dem --example dem_bench)
+
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+out="$("$CARGO_TARGET_DIR/release/examples/dem_bench" $quick --lammps-data "$work/box.data" --steps "$steps")"
+echo "$out"
+lx="$(awk '/^box_x/ {print $2}' <<<"$out")"
+ly="$(awk '/^box_y/ {print $2}' <<<"$out")"
+spatter1="$(awk '/^spatter_threads_1/ {print $2}' <<<"$out")"
+spatter2="$(awk '/^spatter_threads_2/ {print $2}' <<<"$out")"
+
+(cd "$work" && lmp -in "$here/in.box" -var data "$work/box.data" -var lx "$lx" -var ly "$ly" \
+    -var steps "$steps" -log "$work/log.lammps" -screen none)
+loop="$(grep '^Loop time' "$work/log.lammps" | tail -1)"
+echo "LAMMPS: $loop"
+# "Loop time of T on P procs for N steps with M atoms"
+lammps="$(awk '{print $12 * $9 / $4}' <<<"$loop")"
+printf 'LAMMPS   1 thread : %.4e particle-steps/s\n' "$lammps"
+printf 'spatter  1 thread : %.4e particle-steps/s\n' "$spatter1"
+printf 'spatter  2 threads: %.4e particle-steps/s (parallel efficiency %.0f %%)\n' "$spatter2" \
+    "$(awk -v a="$spatter1" -v b="$spatter2" 'BEGIN {print 50 * b / a}')"
+printf 'ratio spatter/LAMMPS (1 thread): %.2f\n' "$(awk -v a="$spatter1" -v b="$lammps" 'BEGIN {print a / b}')"
