@@ -328,12 +328,8 @@ pub struct Boundary {
     /// Wall area represented \[m², m in 2D\].
     pub area: Vec<f64>,
     pub part: Vec<u16>,
-    /// Current world position, velocity, acceleration and normal.
-    pub pos: Vec<Vec3>,
-    pub vel: Vec<Vec3>,
-    pub acc: Vec<Vec3>,
-    pub normal: Vec<Vec3>,
-    /// Current frame of every part.
+    /// Current frame of every part (world position, velocity and so on of particle i follow from
+    /// `frames[part[i]]` and its reference position).
     pub frames: Vec<Frame>,
     /// Wet at the last step.
     pub wet: Vec<bool>,
@@ -372,10 +368,6 @@ impl Boundary {
         self.area.extend(&samples.area);
         self.volume.extend(std::iter::repeat_n(0.0, n));
         self.part.extend(std::iter::repeat_n(idx as u16, n));
-        self.pos.extend(&samples.pos);
-        self.vel.extend(std::iter::repeat_n(Vec3::ZERO, n));
-        self.acc.extend(std::iter::repeat_n(Vec3::ZERO, n));
-        self.normal.extend(&samples.normal);
         self.wet.extend(std::iter::repeat_n(false, n));
         self.wet_time.extend(std::iter::repeat_n(0.0, n));
         let bvh = TriBvh::build(&surface);
@@ -425,27 +417,69 @@ impl Boundary {
         }
     }
 
-    /// Moves every part to its placement at time `t`: world positions, velocities, accelerations, normals.
+    /// Moves every part to its placement at time `t`.
     pub fn update_kinematics(&mut self, tree: &KinematicTree, t: f64) {
         for (k, p) in self.parts.iter().enumerate() {
-            let f = Frame::of(tree, p.node, t);
-            self.frames[k] = f;
-            if f.is_static() && p.node.is_none() {
-                continue;
-            }
-            for i in p.start..p.end {
-                let x = f.to_world(self.ref_pos[i]);
-                self.pos[i] = x;
-                self.vel[i] = f.velocity(x);
-                self.acc[i] = f.acceleration(x);
-                self.normal[i] = f.rot * self.ref_normal[i];
-            }
+            self.frames[k] = Frame::of(tree, p.node, t);
         }
+    }
+
+    /// Current world position of particle `i`.
+    #[inline]
+    pub fn position(&self, i: usize) -> Vec3 {
+        self.frames[self.part[i] as usize].to_world(self.ref_pos[i])
+    }
+
+    /// Current velocity of particle `i` \[m/s\].
+    #[inline]
+    pub fn velocity(&self, i: usize) -> Vec3 {
+        let f = &self.frames[self.part[i] as usize];
+        f.velocity(f.to_world(self.ref_pos[i]))
+    }
+
+    /// Current acceleration of particle `i` \[m/s²\].
+    #[inline]
+    pub fn acceleration(&self, i: usize) -> Vec3 {
+        let f = &self.frames[self.part[i] as usize];
+        f.acceleration(f.to_world(self.ref_pos[i]))
+    }
+
+    /// Current unit normal of particle `i`.
+    #[inline]
+    pub fn normal(&self, i: usize) -> Vec3 {
+        self.frames[self.part[i] as usize].rot * self.ref_normal[i]
+    }
+
+    /// True when some part moves at time of the last kinematics update.
+    pub fn any_moving(&self) -> bool {
+        self.parts.iter().any(|p| p.node.is_some())
     }
 
     /// Largest boundary speed \[m/s\].
     pub fn max_speed(&self) -> f64 {
-        self.vel.iter().map(|v| v.length()).fold(0.0, f64::max)
+        let mut m: f64 = 0.0;
+        for (k, p) in self.parts.iter().enumerate() {
+            if p.node.is_none() {
+                continue;
+            }
+            let f = &self.frames[k];
+            for i in p.start..p.end {
+                m = m.max(f.velocity(f.to_world(self.ref_pos[i])).length_squared());
+            }
+        }
+        m.sqrt()
+    }
+
+    /// Bytes held per wall particle (capacities).
+    pub fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.ref_pos.capacity() * size_of::<Vec3>()
+            + self.ref_normal.capacity() * size_of::<Vec3>()
+            + self.volume.capacity() * 8
+            + self.area.capacity() * 8
+            + self.part.capacity() * 2
+            + self.wet.capacity()
+            + self.wet_time.capacity() * 8
     }
 }
 

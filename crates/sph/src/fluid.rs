@@ -25,12 +25,12 @@ pub struct Fluid {
     pub shift: Vec<Vec3>,
 }
 
-/// Reusable buffers for permuting the arrays without allocating.
-#[derive(Clone, Debug, Default)]
-pub struct PermuteScratch {
-    v3: Vec<Vec3>,
-    f: Vec<f64>,
-    u: Vec<u32>,
+/// Buffers for permuting the arrays without allocating: one of each element type, lent by the caller
+/// (the simulation lends its force buffers, which are free while particles are re-sorted).
+pub struct PermuteScratch<'a> {
+    pub v3: &'a mut Vec<Vec3>,
+    pub f: &'a mut Vec<f64>,
+    pub u: &'a mut Vec<u32>,
 }
 
 fn permute<T: Copy + Send + Sync + Default>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
@@ -70,16 +70,16 @@ impl Fluid {
     }
 
     /// Reorders every array so that new entry `k` is old entry `perm[k]`.
-    pub fn permute(&mut self, perm: &[u32], s: &mut PermuteScratch) {
+    pub fn permute(&mut self, perm: &[u32], s: PermuteScratch) {
         debug_assert_eq!(perm.len(), self.len());
-        permute(&mut self.pos, perm, &mut s.v3);
-        permute(&mut self.vel, perm, &mut s.v3);
-        permute(&mut self.acc, perm, &mut s.v3);
-        permute(&mut self.shift, perm, &mut s.v3);
-        permute(&mut self.rho, perm, &mut s.f);
-        permute(&mut self.drho, perm, &mut s.f);
-        permute(&mut self.id, perm, &mut s.u);
-        permute(&mut self.near, perm, &mut s.u);
+        permute(&mut self.pos, perm, s.v3);
+        permute(&mut self.vel, perm, s.v3);
+        permute(&mut self.acc, perm, s.v3);
+        permute(&mut self.shift, perm, s.v3);
+        permute(&mut self.rho, perm, s.f);
+        permute(&mut self.drho, perm, s.f);
+        permute(&mut self.id, perm, s.u);
+        permute(&mut self.near, perm, s.u);
     }
 
     /// Keeps the particles with `keep[i]`, in order.
@@ -125,8 +125,8 @@ mod tests {
         for i in 0..5 {
             f.push(Vec3::splat(i as f64), Vec3::X * i as f64, 1000.0 + i as f64, i, true);
         }
-        let mut s = PermuteScratch::default();
-        f.permute(&[4, 2, 0, 1, 3], &mut s);
+        let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+        f.permute(&[4, 2, 0, 1, 3], PermuteScratch { v3: &mut a, f: &mut b, u: &mut c });
         assert_eq!(f.id, vec![4, 2, 0, 1, 3]);
         for k in 0..5 {
             let i = f.id[k] as f64;

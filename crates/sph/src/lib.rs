@@ -1,6 +1,7 @@
 //! Weakly compressible SPH engine for free-surface water with moving rigid bodies, surface tension,
 //! adhesion, air drag, wetting and splash sensors.
 //!
+//! * [`bench`] — the `spatter bench sph` dam break;
 //! * [`kernel`], [`eos`], [`params`] — kernels (Wendland C2, cubic spline, Akinci splines), Tait equation
 //!   of state, physical and numerical parameters;
 //! * [`fluid`], [`boundary`] — particle storage; walls sampled from boxes and meshes, moving by
@@ -16,6 +17,7 @@
 //!
 //! See `docs/sph.md` for the equations, defaults and references.
 
+pub mod bench;
 pub mod boundary;
 pub mod drag;
 pub mod eos;

@@ -64,6 +64,12 @@ impl NeighbourGrid {
         }
     }
 
+    /// Bytes held (point cells, permutation and cell starts).
+    pub fn bytes(&self) -> usize {
+        let [nx, ny, nz] = self.cells.dims();
+        self.cells.entries().len() * 8 + (nx * ny * nz + 1) * 4
+    }
+
     /// Number of points binned.
     pub fn len(&self) -> usize {
         self.cells.entries().len()

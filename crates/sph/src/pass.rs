@@ -95,7 +95,6 @@ pub(crate) struct FluidSet<'a> {
     pub pr: &'a [f64],
     /// 1/ρ \[m³/kg\].
     pub irho: &'a [f64],
-    pub press: &'a [f64],
     /// Akinci surface normals (empty without surface tension).
     pub nrm: &'a [Vec3],
     pub grid: &'a NeighbourGrid,
@@ -107,7 +106,11 @@ pub(crate) struct WallSet<'a> {
     pub pos: &'a [Vec3],
     /// Wall velocity.
     pub vel: &'a [Vec3],
-    pub acc: &'a [Vec3],
+    /// Canonical index of each entry (entries include periodic images).
+    pub src: &'a [u32],
+    /// Reference positions and part frames, for wall accelerations.
+    pub ref_pos: &'a [Vec3],
+    pub frames: &'a [crate::boundary::Frame],
     /// Dummy velocity for the laminar term.
     pub vvisc: &'a [Vec3],
     pub rho: &'a [f64],
@@ -151,6 +154,7 @@ pub(crate) struct Consts {
     pub w0: f64,
     pub eos_b: f64,
     pub eos_gamma: f64,
+    pub eos: crate::eos::Tait,
     pub wet_d2: f64,
     pub slip_free: Vec<bool>,
 }
@@ -252,7 +256,7 @@ pub(crate) fn wall_state(
                                 if r2 < c.r2max {
                                     let w = kf.w(r2.sqrt());
                                     sw += w;
-                                    spw += set.press[j] * w;
+                                    spw += c.eos.pressure(set.rho[j]) * w;
                                     srx += dx * (set.rho[j] * w);
                                     svw += set.vel[j] * w;
                                     is_wet |= r2 < c.wet_d2;
@@ -261,7 +265,9 @@ pub(crate) fn wall_state(
                         });
                     }
                     let (p, vv) = if sw > 0.0 {
-                        let p = ((spw + (c.g - wl.acc[b]).dot(srx)) / sw).max(0.0);
+                        let f = &wl.frames[wl.part[b] as usize];
+                        let acc_b = f.acceleration(f.to_world(wl.ref_pos[wl.src[b] as usize]));
+                        let p = ((spw + (c.g - acc_b).dot(srx)) / sw).max(0.0);
                         let vt = svw / sw;
                         let vv = if c.slip_free[wl.part[b] as usize] { vt } else { 2.0 * wl.vel[b] - vt };
                         (p, vv)
@@ -541,21 +547,30 @@ fn pair_block<K: KernelFn, const EXTRA: bool>(
         let (mut ai, mut di) = (Vec3::ZERO, 0.0);
         let (mut phi_i, mut gc_i, mut dv_i) = (0.0, Vec3::ZERO, 0.0);
         fl.grid.for_each_run_after(xi, |run| {
-            for j in run.start.max(i + 1)..run.end {
-                let dx = xi - fl.pos[j];
+            let (s, e) = (run.start.max(i + 1), run.end);
+            if s >= e {
+                return;
+            }
+            // Equal-length sub-slices: one bounds check per run instead of one per array and pair.
+            let (pos, vel) = (&fl.pos[s..e], &fl.vel[s..e]);
+            let (rho, irho, pr) = (&fl.rho[s..e], &fl.irho[s..e], &fl.pr[s..e]);
+            let (acc_o, drho_o) =
+                (&mut out.acc[s - offset..e - offset], &mut out.drho[s - offset..e - offset]);
+            for k in 0..pos.len() {
+                let dx = xi - pos[k];
                 let r2 = dx.length_squared();
                 if r2 >= c.r2max {
                     continue;
                 }
                 pairs += 1;
-                let sj = (fl.rho[j], fl.irho[j], fl.pr[j]);
-                let nij = if st { ni - fl.nrm[j] } else { Vec3::ZERO };
-                let (a, dd_i, dd_j, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, vi - fl.vel[j], si, sj, nij);
-                let o = j - offset;
+                let sj = (rho[k], irho[k], pr[k]);
+                let nij = if st { ni - fl.nrm[s + k] } else { Vec3::ZERO };
+                let (a, dd_i, dd_j, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, vi - vel[k], si, sj, nij);
                 ai += a;
-                out.acc[o] -= a;
+                acc_o[k] -= a;
                 di += dd_i;
-                out.drho[o] += dd_j;
+                drho_o[k] += dd_j;
+                let o = s + k - offset;
                 if need_phi {
                     let w = kf.w(r2.sqrt());
                     phi_i += c.m * sj.1 * w;
@@ -767,7 +782,7 @@ pub(crate) fn probe(kernel: &Kernel, c: &Consts, fl: FluidSet, gh: FluidSet, x: 
                 if r2 < c.r2max {
                     let w = kernel.w(r2.sqrt()) * c.m / set.rho[j];
                     sw += w;
-                    sp += w * set.press[j];
+                    sp += w * c.eos.pressure(set.rho[j]);
                     sv += set.vel[j] * w;
                 }
             }

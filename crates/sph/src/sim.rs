@@ -95,10 +95,8 @@ pub struct PhaseTimes {
 #[derive(Clone, Debug, Default)]
 struct Work {
     grid: NeighbourGrid,
-    perm: PermuteScratch,
     perm_buf: Vec<u32>,
-    pos_old: Vec<Vec3>,
-    press: Vec<f64>,
+    perm_u: Vec<u32>,
     pr: Vec<f64>,
     irho: Vec<f64>,
     nrm: Vec<Vec3>,
@@ -116,7 +114,6 @@ struct Work {
     g_rho: Vec<f64>,
     g_pr: Vec<f64>,
     g_irho: Vec<f64>,
-    g_press: Vec<f64>,
     g_nrm: Vec<Vec3>,
     g_grid: NeighbourGrid,
     g_tmp_u: Vec<u32>,
@@ -126,7 +123,6 @@ struct Work {
     w_ghost: Vec<bool>,
     w_pos: Vec<Vec3>,
     w_vel: Vec<Vec3>,
-    w_acc: Vec<Vec3>,
     w_vvisc: Vec<Vec3>,
     w_rho: Vec<f64>,
     w_pr: Vec<f64>,
@@ -138,7 +134,7 @@ struct Work {
     w_grid: NeighbourGrid,
     w_tmp_u: Vec<u32>,
     w_tmp_b: Vec<bool>,
-    w_tmp_v: Vec<Vec3>,
+    walls_built: bool,
     ready: bool,
     times: PhaseTimes,
 }
@@ -435,6 +431,7 @@ impl Simulation {
             w0: k.w0(),
             eos_b: eos.stiffness(),
             eos_gamma: p.gamma,
+            eos,
             wet_d2: p.wet_distance * p.wet_distance,
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }
@@ -450,7 +447,8 @@ impl Simulation {
         if !identity {
             w.perm_buf.clear();
             w.perm_buf.extend_from_slice(w.grid.entries());
-            self.fluid.permute(&w.perm_buf, &mut w.perm);
+            let scratch = PermuteScratch { v3: &mut w.acc_new, f: &mut w.drho_new, u: &mut w.perm_u };
+            self.fluid.permute(&w.perm_buf, scratch);
         }
         self.compute_pressure();
         self.build_fluid_images();
@@ -462,19 +460,14 @@ impl Simulation {
         let eos = self.params.eos();
         let n = self.fluid.len();
         let w = &mut self.work;
-        w.press.resize(n, 0.0);
         w.pr.resize(n, 0.0);
         w.irho.resize(n, 0.0);
-        w.press
-            .par_iter_mut()
-            .zip(w.pr.par_iter_mut())
-            .zip(w.irho.par_iter_mut())
-            .zip(self.fluid.rho.par_iter())
-            .for_each(|(((p, pr), ir), &rho)| {
-                *p = eos.pressure(rho);
+        w.pr.par_iter_mut().zip(w.irho.par_iter_mut()).zip(self.fluid.rho.par_iter()).for_each(
+            |((pr, ir), &rho)| {
                 *ir = 1.0 / rho;
-                *pr = *p * *ir * *ir;
-            });
+                *pr = eos.pressure(rho) * *ir * *ir;
+            },
+        );
     }
 
     /// Images of fluid particles within one support of a periodic face, shifted by the period.
@@ -537,22 +530,25 @@ impl Simulation {
         w.g_pr.extend(w.g_src.iter().map(|&s| w.pr[s as usize]));
         w.g_irho.clear();
         w.g_irho.extend(w.g_src.iter().map(|&s| w.irho[s as usize]));
-        w.g_press.clear();
-        w.g_press.extend(w.g_src.iter().map(|&s| w.press[s as usize]));
     }
 
-    /// The wall particles (and their periodic images) in cell order.
+    /// The wall particles (and their periodic images) in cell order. Static walls without periodic
+    /// images are sorted once.
     fn build_wall_set(&mut self) {
         let support = self.kernel().support();
+        let periodic = self.periodic.iter().any(|&p| p);
         let w = &mut self.work;
         let b = &self.boundary;
+        if w.walls_built && !periodic && !b.any_moving() && w.w_src.len() == b.len() {
+            return;
+        }
         w.w_src.clear();
         w.w_ghost.clear();
         w.w_pos.clear();
         for i in 0..b.len() {
             w.w_src.push(i as u32);
             w.w_ghost.push(false);
-            w.w_pos.push(b.pos[i]);
+            w.w_pos.push(b.position(i));
         }
         for a in 0..3 {
             if !self.periodic[a] {
@@ -581,14 +577,13 @@ impl Simulation {
         w.w_tmp_b.clear();
         w.w_tmp_b.extend(perm.iter().map(|&i| w.w_ghost[i as usize]));
         std::mem::swap(&mut w.w_ghost, &mut w.w_tmp_b);
-        w.w_tmp_v.clear();
-        w.w_tmp_v.extend(perm.iter().map(|&i| w.w_pos[i as usize]));
-        std::mem::swap(&mut w.w_pos, &mut w.w_tmp_v);
+        // The dummy-velocity buffer is free here: use it to permute the positions.
+        w.w_vvisc.clear();
+        w.w_vvisc.extend(perm.iter().map(|&i| w.w_pos[i as usize]));
+        std::mem::swap(&mut w.w_pos, &mut w.w_vvisc);
         let n = w.w_src.len();
         w.w_vel.clear();
-        w.w_vel.extend(w.w_src.iter().map(|&s| b.vel[s as usize]));
-        w.w_acc.clear();
-        w.w_acc.extend(w.w_src.iter().map(|&s| b.acc[s as usize]));
+        w.w_vel.extend(w.w_src.iter().map(|&s| b.velocity(s as usize)));
         w.w_vol.clear();
         w.w_vol.extend(w.w_src.iter().map(|&s| b.volume[s as usize]));
         w.w_part.clear();
@@ -598,6 +593,7 @@ impl Simulation {
         w.w_pr.resize(n, 0.0);
         w.w_irho.resize(n, 0.0);
         w.w_wet.resize(n, false);
+        w.walls_built = true;
     }
 
     /// Wall extrapolation only (probes and loads between steps).
@@ -611,7 +607,6 @@ impl Simulation {
             rho: &self.fluid.rho,
             pr: &w.pr,
             irho: &w.irho,
-            press: &w.press,
             nrm: &[],
             grid: &w.grid,
         };
@@ -621,14 +616,15 @@ impl Simulation {
             rho: &w.g_rho,
             pr: &w.g_pr,
             irho: &w.g_irho,
-            press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
         };
         let wl = WallSet {
             pos: &w.w_pos,
             vel: &w.w_vel,
-            acc: &w.w_acc,
+            src: &w.w_src,
+            ref_pos: &self.boundary.ref_pos,
+            frames: &self.boundary.frames,
             vvisc: &[],
             rho: &[],
             pr: &[],
@@ -682,7 +678,6 @@ impl Simulation {
                 rho: &self.fluid.rho,
                 pr: &w.pr,
                 irho: &w.irho,
-                press: &w.press,
                 nrm: &[],
                 grid: &w.grid,
             };
@@ -692,7 +687,6 @@ impl Simulation {
                 rho: &w.g_rho,
                 pr: &w.g_pr,
                 irho: &w.g_irho,
-                press: &w.g_press,
                 nrm: &[],
                 grid: &w.g_grid,
             };
@@ -713,7 +707,6 @@ impl Simulation {
             rho: &self.fluid.rho,
             pr: &w.pr,
             irho: &w.irho,
-            press: &w.press,
             nrm,
             grid: &w.grid,
         };
@@ -723,14 +716,15 @@ impl Simulation {
             rho: &w.g_rho,
             pr: &w.g_pr,
             irho: &w.g_irho,
-            press: &w.g_press,
             nrm: g_nrm,
             grid: &w.g_grid,
         };
         let wl = WallSet {
             pos: &w.w_pos,
             vel: &w.w_vel,
-            acc: &w.w_acc,
+            src: &w.w_src,
+            ref_pos: &self.boundary.ref_pos,
+            frames: &self.boundary.frames,
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
             pr: &w.w_pr,
@@ -806,8 +800,6 @@ impl Simulation {
             }
         };
         // Predictor and drift.
-        self.work.pos_old.clear();
-        self.work.pos_old.extend_from_slice(&self.fluid.pos);
         {
             let f = &mut self.fluid;
             let shift = &f.shift;
@@ -831,9 +823,9 @@ impl Simulation {
         // Walls move to the new time; the guard stops crossings.
         self.work.frames_old.clear();
         self.work.frames_old.extend_from_slice(&self.boundary.frames);
+        self.count_flux();
         self.boundary.update_kinematics(&self.tree, t1);
         self.last.guard_hits = self.guard();
-        self.count_flux();
         self.wrap_and_remove()?;
         self.work.times.walls_guard += lap();
         // Forces at the new positions.
@@ -876,8 +868,9 @@ impl Simulation {
         let f0s = &self.work.frames_old;
         let f1s = &self.boundary.frames;
         let offset = self.params.guard_offset * self.params.spacing;
-        let old = &self.work.pos_old;
+        let dt = self.dt;
         let f = &mut self.fluid;
+        let (acc, shift) = (&f.acc, &f.shift);
         f.pos
             .par_iter_mut()
             .zip(f.vel.par_iter_mut())
@@ -887,13 +880,14 @@ impl Simulation {
                 if mask == 0 {
                     return 0u64;
                 }
+                let old = old_position(*x, *v, acc[i], shift.get(i).copied(), dt);
                 let mut hit = 0;
                 for (k, part) in parts.iter().enumerate() {
                     let bit = if k < 31 { 1u32 << k } else { 1u32 << 31 };
                     if mask & bit == 0 {
                         continue;
                     }
-                    let g = guard_particle(part, &f0s[k], &f1s[k], old[i], *x, *v, offset);
+                    let g = guard_particle(part, &f0s[k], &f1s[k], old, *x, *v, offset);
                     if g.hit {
                         *x = g.pos;
                         *v = g.vel;
@@ -910,8 +904,10 @@ impl Simulation {
             return;
         }
         let vol0 = self.params.particle_volume();
-        for (i, x) in self.fluid.pos.iter().enumerate() {
-            let (z0, z1) = (self.work.pos_old[i].z, x.z);
+        let f = &self.fluid;
+        for (i, x) in f.pos.iter().enumerate() {
+            let z0 = old_position(*x, f.vel[i], f.acc[i], f.shift.get(i).copied(), self.dt).z;
+            let z1 = x.z;
             if z0 == z1 {
                 continue;
             }
@@ -938,10 +934,9 @@ impl Simulation {
         let lo_rho = self.params.density_window[0] * self.params.rest_density;
         let hi_rho = self.params.density_window[1] * self.params.rest_density;
         let w = &mut self.work;
-        w.keep.clear();
-        w.keep.resize(n, true);
         let mut removed_domain = 0;
         let mut removed_density = 0;
+        let mut first_removed = usize::MAX;
         for i in 0..n {
             let x = &mut self.fluid.pos[i];
             let v = self.fluid.vel[i];
@@ -979,14 +974,22 @@ impl Simulation {
                 }
             }
             if !d.contains(*x) {
-                w.keep[i] = false;
                 removed_domain += 1;
+                first_removed = first_removed.min(i);
             } else if rho < lo_rho || rho > hi_rho {
-                w.keep[i] = false;
                 removed_density += 1;
+                first_removed = first_removed.min(i);
             }
         }
         if removed_domain + removed_density > 0 {
+            // Only now build the mask (no per-step buffer when nothing leaves).
+            w.keep.clear();
+            w.keep.resize(n, true);
+            for i in first_removed..n {
+                let x = self.fluid.pos[i];
+                let rho = self.fluid.rho[i];
+                w.keep[i] = d.contains(x) && rho >= lo_rho && rho <= hi_rho;
+            }
             self.fluid.retain(&w.keep);
             self.removed.outside_domain += removed_domain;
             self.removed.density_window += removed_density;
@@ -1027,7 +1030,6 @@ impl Simulation {
             rho: &self.fluid.rho,
             pr: &w.pr,
             irho: &w.irho,
-            press: &w.press,
             nrm: &[],
             grid: &w.grid,
         };
@@ -1037,14 +1039,15 @@ impl Simulation {
             rho: &w.g_rho,
             pr: &w.g_pr,
             irho: &w.g_irho,
-            press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
         };
         let wl = WallSet {
             pos: &w.w_pos,
             vel: &w.w_vel,
-            acc: &w.w_acc,
+            src: &w.w_src,
+            ref_pos: &self.boundary.ref_pos,
+            frames: &self.boundary.frames,
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
             pr: &w.w_pr,
@@ -1089,7 +1092,6 @@ impl Simulation {
             rho: &self.fluid.rho,
             pr: &w.pr,
             irho: &w.irho,
-            press: &w.press,
             nrm: &[],
             grid: &w.grid,
         };
@@ -1099,7 +1101,6 @@ impl Simulation {
             rho: &w.g_rho,
             pr: &w.g_pr,
             irho: &w.g_irho,
-            press: &w.g_press,
             nrm: &[],
             grid: &w.g_grid,
         };
@@ -1149,36 +1150,58 @@ impl Simulation {
         self.fluid.rho.iter().map(|&r| eos.pressure(r)).collect()
     }
 
-    /// Bytes held by the state and scratch arrays, per fluid particle (walls included in the total).
+    /// Bytes held by the state and every scratch buffer (walls and cell lists included), per fluid
+    /// particle.
     pub fn bytes_per_particle(&self) -> f64 {
-        use std::mem::size_of;
+        fn b<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
         let w = &self.work;
-        let v3 = size_of::<Vec3>();
-        let scratch = w.pos_old.capacity() * v3
-            + w.press.capacity() * 8
-            + w.pr.capacity() * 8
-            + w.nrm.capacity() * v3
-            + w.acc_new.capacity() * v3
-            + w.drho_new.capacity() * 8
-            + w.keep.capacity()
-            + grid_bytes(&w.grid, self.fluid.len())
-            + perm_bytes(self.fluid.len());
-        let walls = w.w_src.capacity() * 4
-            + w.w_pos.capacity() * v3 * 4
-            + w.w_rho.capacity() * 8 * 3
-            + w.w_part.capacity() * 2
-            + w.w_wet.capacity() * 2
-            + self.boundary.len() * (v3 * 6 + 8 * 3 + 2 + 1);
-        (self.fluid.bytes() + scratch + walls) as f64 / self.fluid.len().max(1) as f64
+        let fluid_scratch = b(&w.pr)
+            + b(&w.irho)
+            + b(&w.nrm)
+            + b(&w.acc_new)
+            + b(&w.drho_new)
+            + b(&w.phi)
+            + b(&w.gradc)
+            + b(&w.divr)
+            + b(&w.keep)
+            + b(&w.perm_buf)
+            + b(&w.perm_u)
+            + w.grid.bytes();
+        let images = b(&w.g_src)
+            + b(&w.g_pos)
+            + b(&w.g_vel)
+            + b(&w.g_rho)
+            + b(&w.g_pr)
+            + b(&w.g_irho)
+            + b(&w.g_nrm)
+            + b(&w.g_tmp_u)
+            + b(&w.g_tmp_v)
+            + w.g_grid.bytes();
+        let walls = self.boundary.bytes()
+            + b(&w.w_src)
+            + b(&w.w_ghost)
+            + b(&w.w_pos)
+            + b(&w.w_vel)
+            + b(&w.w_vvisc)
+            + b(&w.w_rho)
+            + b(&w.w_pr)
+            + b(&w.w_irho)
+            + b(&w.w_vol)
+            + b(&w.w_part)
+            + b(&w.w_wet)
+            + b(&w.w_load)
+            + b(&w.w_tmp_u)
+            + b(&w.w_tmp_b)
+            + w.w_grid.bytes();
+        (self.fluid.bytes() + fluid_scratch + images + walls) as f64 / self.fluid.len().max(1) as f64
     }
 }
 
-fn grid_bytes(_g: &NeighbourGrid, n: usize) -> usize {
-    // Cell starts (about one cell per particle in a filled region) plus two u32 per point.
-    n * 4 + n * 8
-}
-
-fn perm_bytes(n: usize) -> usize {
-    // The permutation scratch holds one Vec3, one f64 and one u32 array.
-    n * (24 + 8 + 4)
+/// Position before the drift of the current step, from the drifted position, the predicted velocity
+/// `v* = v + dt a`, the acceleration and the shift: `x − dt (v* − ½ dt a) − shift`.
+#[inline]
+fn old_position(x: Vec3, v_pred: Vec3, a: Vec3, shift: Option<Vec3>, dt: f64) -> Vec3 {
+    x - (v_pred - a * (0.5 * dt)) * dt - shift.unwrap_or(Vec3::ZERO)
 }

@@ -2,7 +2,7 @@
 
 use super::build::{build, BuildInfo};
 use super::config::SphConfig;
-use super::wetting::{default_view, wet_area, wetting_map};
+use super::wetting::{default_view, particle_map, wet_area, wetting_map};
 use crate::error::SphError;
 use crate::sim::Simulation;
 use serde::{Deserialize, Serialize};
@@ -124,9 +124,13 @@ fn write_walls(path: &Path, sim: &Simulation) -> std::io::Result<()> {
     let b = &sim.boundary;
     let part: Vec<i64> = b.part.iter().map(|&p| p as i64).collect();
     let wet: Vec<i64> = b.wet.iter().map(|&w| w as i64).collect();
-    Vtu::point_cloud(&b.pos)
-        .point_vector("velocity_m_s", &b.vel)
-        .point_vector("normal", &b.normal)
+    let n = b.len();
+    let pos: Vec<Vec3> = (0..n).map(|i| b.position(i)).collect();
+    let vel: Vec<Vec3> = (0..n).map(|i| b.velocity(i)).collect();
+    let nrm: Vec<Vec3> = (0..n).map(|i| b.normal(i)).collect();
+    Vtu::point_cloud(&pos)
+        .point_vector("velocity_m_s", &vel)
+        .point_vector("normal", &nrm)
         .point_scalar("area_m2", &b.area)
         .point_scalar("volume_m3", &b.volume)
         .point_scalar("wet_time_s", &b.wet_time)
@@ -397,10 +401,11 @@ fn finish(
         let view = wcfg.and_then(|w| w.view_dir).unwrap_or(dv);
         let up = wcfg.and_then(|w| w.up).unwrap_or(du);
         let png = dir.path(&format!("wetting/{name}.png"));
+        let (squares, fraction) = particle_map(&sim, k, elapsed);
         spatter_io::plot::mesh_map_png(
             &png,
-            &map.mesh,
-            &map.wet_time_fraction,
+            &squares,
+            &fraction,
             view,
             up,
             &format!("{name}: fraction of time wet (0–{elapsed:.3} s)"),

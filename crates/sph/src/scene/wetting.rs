@@ -77,9 +77,9 @@ pub fn wetting_map(sim: &Simulation, k: usize, elapsed: f64) -> WettingMap {
                 if b.area[i] <= 0.0 {
                     continue;
                 }
-                let n = b.normal[i];
+                let n = b.normal(i);
                 // First-layer lattice particles sit dp/2 behind the face they stand for.
-                let c = b.pos[i] + n * (0.5 * dp);
+                let c = b.position(i) + n * (0.5 * dp);
                 let (u, v) = orthonormal_basis(n);
                 let (u, v) = (u * (0.5 * dp), v * (0.5 * dp));
                 let (p0, p1, p2, p3) = (c - u - v, c + u - v, c + u + v, c - u + v);
@@ -101,17 +101,59 @@ pub fn wetting_map(sim: &Simulation, k: usize, elapsed: f64) -> WettingMap {
     }
 }
 
+/// Wetting of part `k` at wall-particle resolution: one square per first-layer wall particle, centred on
+/// the wall surface, with the area the particle stands for (used for the pictures: sharp whatever the
+/// triangulation). Returns the squares and, per triangle, the wet-time fraction.
+pub fn particle_map(sim: &Simulation, k: usize, elapsed: f64) -> (TriMesh, Vec<f64>) {
+    let part = &sim.boundary.parts[k];
+    let b = &sim.boundary;
+    let dp = sim.params.spacing;
+    let t = elapsed.max(f64::MIN_POSITIVE);
+    let lattice = matches!(part.sampling, Sampling::Lattice);
+    let mut soup = Vec::new();
+    let mut frac = Vec::new();
+    for i in part.start..part.end {
+        let a = b.area[i];
+        if a <= 0.0 {
+            continue;
+        }
+        let n = b.normal(i);
+        // Lattice particles sit dp/2 behind the face they stand for; mesh samples lie on the surface.
+        let c = if lattice { b.position(i) + n * (0.5 * dp) } else { b.position(i) };
+        let side = if sim.params.dim == crate::kernel::Dim::Two { dp } else { a.sqrt() };
+        let (u, v) = orthonormal_basis(n);
+        let (u, v) = (u * (0.5 * side), v * (0.5 * side));
+        let (p0, p1, p2, p3) = (c - u - v, c + u - v, c + u + v, c - u + v);
+        soup.extend([p0, p1, p2, p0, p2, p3]);
+        let f = (b.wet_time[i] / t).min(1.0);
+        frac.extend([f, f]);
+    }
+    let mesh = TriMesh {
+        vertices: soup.clone(),
+        triangles: (0..soup.len() / 3).map(|q| [3 * q as u32, 3 * q as u32 + 1, 3 * q as u32 + 2]).collect(),
+    };
+    (mesh, frac)
+}
+
 /// A view direction and up vector that look at the part's main face.
 pub fn default_view(sim: &Simulation, k: usize) -> (Vec3, Vec3) {
     let part = &sim.boundary.parts[k];
     let b = &sim.boundary;
     let mut n = Vec3::ZERO;
     for i in part.start..part.end {
-        n += b.normal[i] * b.area[i];
+        n += b.normal(i) * b.area[i];
     }
     let total: f64 = b.area[part.start..part.end].iter().sum();
     let mean = if total > 0.0 { n / total } else { Vec3::ZERO };
-    let view = if mean.length() > 0.3 { -mean.normalize() } else { Vec3::new(0.3, 1.0, -0.4).normalize() };
+    // Containers (normals pointing inwards, open top) are seen from above; other walls face the viewer
+    // with their mean normal.
+    let view = if mean.length() > 0.3 {
+        -mean.normalize()
+    } else if mean.z > 0.0 {
+        -Vec3::Z
+    } else {
+        Vec3::new(0.3, 1.0, -0.4).normalize()
+    };
     let up = if view.z.abs() > 0.9 { Vec3::Y } else { Vec3::Z };
     (view, up)
 }
