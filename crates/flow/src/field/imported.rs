@@ -689,6 +689,36 @@ mod tests {
     }
 
     #[test]
+    fn time_series_interpolates_holds_and_cycles() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, ux: f64| {
+            let text = format!(
+                "# vtk DataFile Version 2.0\nframe\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 float\n0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\nPOINT_DATA 4\nVECTORS U float\n{ux} 0 0 {ux} 0 0 {ux} 0 0 {ux} 0 0\n"
+            );
+            let p = dir.path().join(name);
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let files = vec![(1.0, write("b.vtk", 3.0)), (0.0, write("a.vtk", 1.0))];
+        let x = Vec3::new(0.1, 0.1, 0.1);
+        let f = ImportedField::load(&files, &ImportOptions::default()).unwrap();
+        assert_eq!(f.times(), vec![0.0, 1.0], "sorted by time");
+        let mut h = NONE;
+        let s = f.sample(x, 0.25, &mut h, false).unwrap();
+        assert!((s.u.x - 1.5).abs() < 1e-12 && (s.du_dt.x - 2.0).abs() < 1e-12);
+        assert_eq!(f.sample(x, 5.0, &mut h, false).unwrap().u.x, 3.0, "held after the last frame");
+        assert_eq!(f.sample(x, -1.0, &mut h, false).unwrap().u.x, 1.0, "held before the first");
+        // Cyclic with period 2: t = 1.5 lies halfway from the last frame back to the first (at t = 2).
+        let opts = ImportOptions { period: Some(2.0), ..Default::default() };
+        let f = ImportedField::load(&files, &opts).unwrap();
+        assert!((f.sample(x, 1.5, &mut h, false).unwrap().u.x - 2.0).abs() < 1e-12);
+        assert!((f.sample(x, 4.25, &mut h, false).unwrap().u.x - 1.5).abs() < 1e-12);
+        // A period shorter than the series is refused.
+        let opts = ImportOptions { period: Some(0.5), ..Default::default() };
+        assert!(ImportedField::load(&files, &opts).unwrap_err().to_string().contains("period_s"));
+    }
+
+    #[test]
     fn missing_velocity_is_named() {
         let ds = tet_dataset(1);
         let e = ImportedField::from_dataset(&ds, &ImportOptions::default()).unwrap_err().to_string();

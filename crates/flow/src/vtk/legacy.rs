@@ -285,13 +285,30 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<VtkDataset, VtkError> {
                 return Err(VtkError::format(path, format!("{n} cells but {} cell types", ds.cell_types.len())));
             }
             if let Some(off) = offsets_51 {
-                ds.cell_offsets = off.iter().map(|&o| o as usize).collect();
-                if ds.cell_offsets.last().copied() != Some(conn.len()) {
-                    return Err(VtkError::format(path, "the last cell offset does not match the connectivity size"));
+                let offsets: Vec<usize> = off.iter().map(|&o| o as usize).collect();
+                if offsets.last().copied() != Some(conn.len()) || offsets.windows(2).any(|w| w[1] < w[0]) {
+                    return Err(VtkError::format(path, "cell offsets are not increasing or do not end at the connectivity size"));
                 }
-                ds.connectivity = conn;
                 if ds.cell_types.contains(&cell_type::POLYHEDRON) {
-                    return Err(VtkError::unsupported(path, "polyhedral cells in a version 5.1 legacy file; write XML (.vtu) or decompose polyhedra"));
+                    // VTK 9 writes a polyhedron's connectivity as its face stream [n_faces, n_0, ids…, …].
+                    ds.cell_offsets = vec![0];
+                    ds.poly_faces = vec![Vec::new(); n];
+                    for i in 0..n {
+                        let row = &conn[offsets[i]..offsets[i + 1]];
+                        if ds.cell_types[i] == cell_type::POLYHEDRON {
+                            let (ids, stream) = super::xml::polyhedron_points(row).ok_or_else(|| {
+                                VtkError::format(path, format!("cell {i}: malformed polyhedron face stream"))
+                            })?;
+                            ds.connectivity.extend_from_slice(&ids);
+                            ds.poly_faces[i] = stream;
+                        } else {
+                            ds.connectivity.extend_from_slice(row);
+                        }
+                        ds.cell_offsets.push(ds.connectivity.len());
+                    }
+                } else {
+                    ds.cell_offsets = offsets;
+                    ds.connectivity = conn;
                 }
             } else {
                 split_legacy_cells(&mut ds, n, &conn, path)?;
