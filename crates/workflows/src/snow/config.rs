@@ -22,6 +22,8 @@ pub enum Mode {
     Sensitivity,
     /// Stick probability against normal speed on a bed of frozen spheres.
     RoughWall,
+    /// One impact recorded step by step (force–overlap loop, trajectory).
+    Single,
 }
 
 /// What the particle hits in grid and bisection modes.
@@ -576,6 +578,32 @@ impl Validate for RoughWallConfig {
     }
 }
 
+/// `[single]`: the impact of `mode = "single"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SingleConfig {
+    /// Particle diameter \[m\].
+    pub diameter_m: f64,
+    /// Normal impact speed \[m/s\].
+    pub normal_speed_m_s: f64,
+    /// Tangential impact speed \[m/s\].
+    pub tangential_speed_m_s: f64,
+}
+
+impl Default for SingleConfig {
+    fn default() -> Self {
+        SingleConfig { diameter_m: 10e-6, normal_speed_m_s: 10.0, tangential_speed_m_s: 0.0 }
+    }
+}
+
+impl Validate for SingleConfig {
+    fn validate(&self, c: &mut Checker) {
+        c.positive("diameter_m", self.diameter_m);
+        c.positive("normal_speed_m_s", self.normal_speed_m_s);
+        c.non_negative("tangential_speed_m_s", self.tangential_speed_m_s);
+    }
+}
+
 /// The `snow_regime_map` scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -608,6 +636,8 @@ pub struct SnowConfig {
     pub sensitivity: SensitivityConfig,
     #[serde(default)]
     pub rough_wall: RoughWallConfig,
+    #[serde(default)]
+    pub single: SingleConfig,
     /// Also write SVG versions of the pictures.
     #[serde(default = "yes")]
     pub svg: bool,
@@ -643,6 +673,7 @@ impl Default for SnowConfig {
             fit: FitConfig::default(),
             sensitivity: SensitivityConfig::default(),
             rough_wall: RoughWallConfig::default(),
+            single: SingleConfig::default(),
             svg: true,
         }
     }
@@ -665,5 +696,6 @@ impl Validate for SnowConfig {
         c.item("fit", &self.fit);
         c.item("sensitivity", &self.sensitivity);
         c.item("rough_wall", &self.rough_wall);
+        c.item("single", &self.single);
     }
 }

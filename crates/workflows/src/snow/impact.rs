@@ -204,12 +204,33 @@ struct Loads {
     u_break: f64,
     max_overlap: f64,
     slip: f64,
+    /// Sum of the signed normal forces of all contacts \[N\] and the largest overlap of an active contact
+    /// (−∞ without contacts), for traces.
+    normal_force: f64,
+    active_overlap: f64,
+}
+
+/// One time step of a traced impact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TracePoint {
+    /// Time since first touch \[s\].
+    pub t: f64,
+    /// Largest overlap of an active contact \[m\] (NaN without contact).
+    pub overlap: f64,
+    /// Sum of the signed normal contact forces on the particle \[N\] (positive repulsive).
+    pub normal_force: f64,
+    /// Particle centre \[m\] and velocity \[m/s\] (relative to a free partner).
+    pub position: [f64; 3],
+    pub velocity: [f64; 3],
+    /// Active contacts.
+    pub contacts: usize,
 }
 
 /// Runs one impact with contact law `law` and its pair parameters `params`.
 ///
 /// `break_energy(r_eff)` is the energy \[J\] needed to break a freshly formed contact of effective radius
-/// `r_eff` (JKR neck work; 0 for laws without a neck).
+/// `r_eff` (JKR neck work; 0 for laws without a neck). With `trace`, every step is recorded and the run
+/// continues to the check time (no early decision), so the whole history is seen.
 pub fn run_impact<L: ContactLaw>(
     law: &L,
     params: &L::Params,
@@ -217,6 +238,7 @@ pub fn run_impact<L: ContactLaw>(
     target: Target<'_>,
     imp: &Impact,
     s: &DriverSettings,
+    mut trace: Option<&mut Vec<TracePoint>>,
 ) -> ImpactResult {
     let p = imp.particle;
     let r = p.radius;
@@ -254,7 +276,7 @@ pub fn run_impact<L: ContactLaw>(
                    slots: &mut Vec<Slot<L::State>>,
                    candidates: &mut Vec<usize>,
                    lc: &mut Vec3| {
-        let mut l = Loads::default();
+        let mut l = Loads { active_overlap: f64::NEG_INFINITY, ..Loads::default() };
         let mut visit = |id: usize, g: Geom, slots: &mut Vec<Slot<L::State>>| {
             let pos = slots.iter().position(|sl| sl.id == id);
             let r_eff = if g.r_partner.is_infinite() { r } else { r * g.r_partner / (r + g.r_partner) };
@@ -301,6 +323,8 @@ pub fn run_impact<L: ContactLaw>(
                     l.energy += out.energy;
                     l.u_break += slots[idx].u_break;
                     l.max_overlap = l.max_overlap.max(g.overlap);
+                    l.active_overlap = l.active_overlap.max(g.overlap);
+                    l.normal_force += out.normal_force;
                     let vt = v_rel - v_rel.dot(g.n) * g.n;
                     l.slip = l.slip.max(vt.length());
                 }
@@ -349,6 +373,20 @@ pub fn run_impact<L: ContactLaw>(
 
     let mut loads = compute(&b, &mut slots, &mut candidates, &mut list_centre);
     let mut max_overlap = loads.max_overlap;
+    let record = |trace: &mut Option<&mut Vec<TracePoint>>, t: f64, b: &Bodies, l: &Loads, n: usize| {
+        if let Some(tr) = trace.as_deref_mut() {
+            tr.push(TracePoint {
+                t,
+                overlap: if n > 0 { l.active_overlap } else { f64::NAN },
+                normal_force: l.normal_force,
+                position: (b.x - b.xp).to_array(),
+                velocity: (b.v - b.vp).to_array(),
+                contacts: n,
+            });
+        }
+    };
+    record(&mut trace, 0.0, &b, &loads, slots.len());
+    let tracing = trace.is_some();
     let mut last_contact_time = 0.0;
     let mut t = 0.0;
     let max_steps = (s.check_time / dt).ceil().max(1.0) as u64;
@@ -389,6 +427,7 @@ pub fn run_impact<L: ContactLaw>(
         }
         steps += 1;
         t += dt;
+        record(&mut trace, t, &b, &loads, slots.len());
         max_overlap = max_overlap.max(loads.max_overlap);
         if !slots.is_empty() {
             last_contact_time = t;
@@ -405,7 +444,7 @@ pub fn run_impact<L: ContactLaw>(
                 decision = Decision::Bound;
                 break;
             }
-        } else if receding(target, &b, r, bed_range) {
+        } else if !tracing && receding(target, &b, r, bed_range) {
             decision = Decision::Separated;
             break;
         }

@@ -2,7 +2,9 @@
 //! (chosen once per call from the configuration, then monomorphised), time step and check time.
 
 use super::config::{ContactConfig, CorModulus, IntegrationConfig, NormalLawKind, TargetKind};
-use super::impact::{run_impact, BedSphere, DriverSettings, Impact, ImpactResult, Sphere, Target};
+use super::impact::{
+    run_impact, BedSphere, DriverSettings, Impact, ImpactResult, Sphere, Target, TracePoint,
+};
 use spatter_core::material::{effective_modulus, Material};
 use spatter_dem::adhesion::{Jkr, JkrLaw};
 use spatter_dem::contact::{
@@ -148,6 +150,20 @@ impl ImpactModel {
         aim: [f64; 2],
         surface: Surface<'_>,
     ) -> (ImpactResult, RunSetup) {
+        self.simulate_traced(d, v_n, v_t, aim, surface, None)
+    }
+
+    /// [`ImpactModel::simulate`], recording every step into `trace` when given (the run then lasts to the
+    /// check time).
+    pub fn simulate_traced(
+        &self,
+        d: f64,
+        v_n: f64,
+        v_t: f64,
+        aim: [f64; 2],
+        surface: Surface<'_>,
+        trace: Option<&mut Vec<TracePoint>>,
+    ) -> (ImpactResult, RunSetup) {
         let (props, setup) = self.setup(d, v_n, surface);
         let (_, rp, mp) = self.partner(d, surface);
         let target = match surface {
@@ -171,14 +187,15 @@ impl ImpactModel {
             tangential_speed: v_t,
             aim,
         };
-        struct Run<'a> {
+        struct Run<'a, 't> {
+            trace: Option<&'t mut Vec<TracePoint>>,
             props: &'a PairProps,
             target: Target<'a>,
             impact: &'a Impact,
             settings: &'a DriverSettings,
             contact: &'a ContactConfig,
         }
-        impl LawVisitor for Run<'_> {
+        impl LawVisitor for Run<'_, '_> {
             type Output = ImpactResult;
             fn visit<L: ContactLaw>(self, law: &L) -> ImpactResult {
                 let params = law.params(0, self.props);
@@ -195,12 +212,19 @@ impl ImpactModel {
                         0.0
                     }
                 };
-                run_impact(law, &params, &break_energy, self.target, self.impact, self.settings)
+                run_impact(law, &params, &break_energy, self.target, self.impact, self.settings, self.trace)
             }
         }
         let result = with_law(
             &self.contact,
-            Run { props: &props, target, impact: &impact, settings: &settings, contact: &self.contact },
+            Run {
+                trace,
+                props: &props,
+                target,
+                impact: &impact,
+                settings: &settings,
+                contact: &self.contact,
+            },
         );
         (result, setup)
     }

@@ -158,6 +158,7 @@ pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowErr
         Mode::Bisection => run_bisection(cfg, ctx)?,
         Mode::Sensitivity => run_sensitivity(cfg, ctx)?,
         Mode::RoughWall => run_rough_wall(cfg, ctx)?,
+        Mode::Single => run_single(cfg, ctx)?,
     };
     if summary.finished == Finished::Completed {
         let mut lines = material_report(cfg);
@@ -177,6 +178,10 @@ pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
             let v = cfg.rough_wall.speed_axis(cfg.grid.velocity_scale_m_s);
             let d = cfg.rough_wall.particle_diameter_m;
             (vec![d, d], v.last().copied().unwrap_or(1.0), Some(0.5 * cfg.rough_wall.bed_sphere_diameter_m))
+        }
+        Mode::Single => {
+            let d = cfg.single.diameter_m;
+            (vec![d, d], cfg.single.normal_speed_m_s, None)
         }
         _ => {
             let d = cfg.grid.diameter_axis();
@@ -660,6 +665,90 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
         speeds.len(),
         any_stick_max.map_or("none".into(), |v| format!("{v:.4} m/s ({:.4} normalised)", v / v_scale)),
         v_flat.v_crit
+    ));
+    Ok(s)
+}
+
+fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
+    use super::config::NormalLawKind;
+    let sc = &cfg.single;
+    let model = model_of(cfg);
+    let mut trace = Vec::new();
+    let (r, setup) = model.simulate_traced(
+        sc.diameter_m,
+        sc.normal_speed_m_s,
+        sc.tangential_speed_m_s,
+        [0.0, 0.0],
+        Surface::Configured,
+        Some(&mut trace),
+    );
+    let mut s = RunSummary::new(Finished::Completed);
+    let tpath = ctx.dir.path("trace.csv");
+    let mut csv = spatter_io::csv::CsvSeries::create(
+        &tpath,
+        &["t_s", "overlap_m", "normal_force_N", "x_m", "z_m", "vx_m_s", "vz_m_s", "contacts"],
+    )?;
+    for p in &trace {
+        csv.row(&[
+            p.t,
+            p.overlap,
+            p.normal_force,
+            p.position[0],
+            p.position[2],
+            p.velocity[0],
+            p.velocity[2],
+            p.contacts as f64,
+        ])?;
+    }
+    csv.flush()?;
+    s.artifacts.push(("every time step".into(), tpath));
+    // Force–overlap loop, normalised by the JKR scales when the law is JKR (thesis Fig. 6).
+    let jkr = (cfg.contact.normal_law == NormalLawKind::Jkr && cfg.contact.work_of_adhesion_j_m2 > 0.0).then(
+        || spatter_dem::adhesion::Jkr::new(setup.e_star, setup.r_star, cfg.contact.work_of_adhesion_j_m2),
+    );
+    let (fs, ds, xl, yl) = match &jkr {
+        Some(j) => (j.pull_off_force, j.critical_overlap, "overlap / δ_c", "normal force / F_c"),
+        None => (1.0, 1.0, "overlap [m]", "normal force [N]"),
+    };
+    let pts: Vec<(f64, f64)> = trace
+        .iter()
+        .filter(|p| p.overlap.is_finite())
+        .map(|p| (p.overlap / ds, p.normal_force / fs))
+        .collect();
+    let mut chart = Chart::new(
+        &format!(
+            "Force–overlap history: d = {:.3e} m at {} m/s ({:?})",
+            sc.diameter_m, sc.normal_speed_m_s, r.outcome
+        ),
+        xl,
+        yl,
+    )
+    .line_colored("simulated (elastic + damping)", &pts, output::STICK_RGB);
+    if let Some(j) = &jkr {
+        let d_max = pts.iter().map(|p| p.0).fold(0.0, f64::max).max(1.0);
+        let curve: Vec<(f64, f64)> = (0..=400)
+            .filter_map(|i| {
+                let x = -1.0 + (d_max + 1.0) * i as f64 / 400.0;
+                j.force(x * j.critical_overlap).map(|f| (x, f / j.pull_off_force))
+            })
+            .collect();
+        chart = chart.dashed("JKR curve (elastic)", &curve, output::BOUNCE_RGB);
+    }
+    let png = output::save_chart(&chart, ctx.dir, "force_overlap", cfg.svg)?;
+    s.artifacts.push(("force–overlap loop".into(), png));
+    s.headline.push(format!(
+        "single impact d = {:.3e} m, v_n = {} m/s, v_t = {} m/s: {:?} ({:?}), restitution input {:.4}, realised {:.4}, max overlap {:.4e} m, contact {:.4e} s, {} steps of {:.4e} s",
+        sc.diameter_m,
+        sc.normal_speed_m_s,
+        sc.tangential_speed_m_s,
+        r.outcome,
+        r.decision,
+        setup.restitution_input,
+        r.restitution,
+        r.max_overlap,
+        r.contact_duration,
+        r.steps,
+        setup.dt
     ));
     Ok(s)
 }

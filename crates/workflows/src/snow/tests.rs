@@ -164,6 +164,7 @@ fn interrupted_and_resumed_runs_equal_uninterrupted_ones() {
                 Mode::Bisection => "critical_speed.png",
                 Mode::Sensitivity => "sensitivity_boundaries.png",
                 Mode::RoughWall => "stick_probability.png",
+                Mode::Single => "force_overlap.png",
             })
             .exists());
     }

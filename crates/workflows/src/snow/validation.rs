@@ -125,6 +125,23 @@ fn elastic_sticking_speed(quick: bool) -> Vec<Check> {
             "VERIFICATION.md JKR: undamped sphere on a rigid-mass wall",
         ));
     }
+    // Above V_s an undamped grain loses exactly the neck work: e = √(1 − (V_s/v)²). The break happens
+    // inside a step (first-order error): tolerance 5e-3 at 200 steps per contact (measured ≤ 2e-3).
+    let j = ice_abs_jkr(10e-6, 0.2);
+    let m = 920.0 * std::f64::consts::PI / 6.0 * 1e-15;
+    let v_s = 1.367847 * (j.pull_off_force * j.critical_overlap / m).sqrt();
+    let ks: &[f64] = if quick { &[2.0] } else { &[1.2, 2.0, 5.0] };
+    for &k in ks {
+        let (r, _) = model.simulate(10e-6, k * v_s, 0.0, [0.0, 0.0], super::model::Surface::Configured);
+        out.push(Check::relative(
+            c,
+            format!("undamped rebound e at v = {k} V_s (d = 10 µm) [-]"),
+            (1.0 - 1.0 / (k * k)).sqrt(),
+            r.restitution,
+            5e-3,
+            "energy balance: ½mv_out² = ½mv² − W_neck (VERIFICATION.md JKR)",
+        ));
+    }
     // The load-controlled break needs less work: V_s = √(2·0.462014 F_cδ_c/m).
     let j = ice_abs_jkr(10e-6, 0.2);
     let m = 920.0 * std::f64::consts::PI / 6.0 * 1e-15;
