@@ -30,6 +30,10 @@ pub(crate) trait KernelFn: Copy + Send + Sync {
     fn w(&self, r: f64) -> f64;
     /// `(1/r) dW/dr` for `r` below the support radius.
     fn f(&self, r: f64) -> f64;
+    /// `(1/h, c)` when `F(r) = c (1 − r/(2h))³` (Wendland C2), for the single-precision batches.
+    fn wendland(&self) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -51,6 +55,9 @@ impl KernelFn for Wendland {
     fn f(&self, r: f64) -> f64 {
         let t = 1.0 - 0.5 * r * self.inv_h;
         self.c * t * t * t
+    }
+    fn wendland(&self) -> Option<(f64, f64)> {
+        Some((self.inv_h, self.c))
     }
 }
 
@@ -160,8 +167,9 @@ pub(crate) struct Consts {
 }
 
 impl Consts {
+    /// Surface tension, drag or shifting: terms beyond pressure, viscosity and continuity.
     fn extra(&self) -> bool {
-        self.nu > 0.0 || self.gamma_st > 0.0 || self.drag.enabled || self.shift_a > 0.0
+        self.gamma_st > 0.0 || self.drag.enabled || self.shift_a > 0.0
     }
 }
 
@@ -310,10 +318,8 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     let s = -(pri + wl.pr[b]) + c.av * mu * (irhoi + irhob);
     let mut acc = dx * (mb * s * f);
     let d = mb * vr * f;
+    acc += (vi - wl.vvisc[b]) * (mb * c.nu * (irhoi + irhob) * r2 * f * inv_d);
     if EXTRA {
-        if c.nu > 0.0 {
-            acc += (vi - wl.vvisc[b]) * (mb * c.nu * (irhoi + irhob) * r2 * f * inv_d);
-        }
         if c.gamma_st > 0.0 && r > 0.0 {
             let beta = c.beta[wl.part[b] as usize];
             if beta != 0.0 {
@@ -408,10 +414,8 @@ fn pair_terms<K: KernelFn, const EXTRA: bool>(
         di += psi * irhoj;
         dj -= psi * irhoi;
     }
+    a += vij * (c.m * c.nu * (irhoi + irhoj) * r2 * f * inv_d);
     if EXTRA {
-        if c.nu > 0.0 {
-            a += vij * (c.m * c.nu * (irhoi + irhoj) * r2 * f * inv_d);
-        }
         if c.gamma_st > 0.0 && r > 0.0 {
             let kij = 2.0 * c.rho0 / (rhoi + rhoj);
             let coh = akinci_cohesion(r, c.support);
@@ -460,9 +464,23 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
                    near_c: &mut [u32],
                    mut shift_c: Option<&mut [Vec3]>| {
         let mut st = PassStats::default();
+        let mut scratch = WallScratch { list: [0; BATCH], batch: Batch::new() };
         for o in 0..acc_c.len() {
             let i = ci * CHUNK + o;
-            let r = finish_particle::<K, EXTRA>(kf, c, i, &fl, &gh, &wl, acc_c[o], d_c[o], phi, gradc, divr);
+            let r = finish_particle::<K, EXTRA>(
+                kf,
+                c,
+                i,
+                &fl,
+                &gh,
+                &wl,
+                acc_c[o],
+                d_c[o],
+                phi,
+                gradc,
+                divr,
+                &mut scratch,
+            );
             acc_c[o] = r.acc;
             d_c[o] = r.drho;
             near_c[o] = r.near;
@@ -534,69 +552,336 @@ fn pair_block<K: KernelFn, const EXTRA: bool>(
     offset: usize,
     out: &mut Acc,
 ) -> u64 {
-    let need_phi = EXTRA && c.drag.enabled;
-    let need_shift = EXTRA && c.shift_a > 0.0;
-    let st = EXTRA && c.gamma_st > 0.0;
+    // Neighbours are first collected without branching (a candidate is written and the count advanced
+    // only when it is within the support), then evaluated in a loop free of unpredictable branches.
+    const CAP: usize = 256;
+    let mut list = [0u32; CAP];
+    let mut batch = Batch::new();
     let mut pairs = 0u64;
     for i in home {
         let xi = fl.pos[i];
-        let vi = fl.vel[i];
-        let si = (fl.rho[i], fl.irho[i], fl.pr[i]);
-        let ni = if st { fl.nrm[i] } else { Vec3::ZERO };
-        let vol_i = c.m * si.1;
-        let (mut ai, mut di) = (Vec3::ZERO, 0.0);
-        let (mut phi_i, mut gc_i, mut dv_i) = (0.0, Vec3::ZERO, 0.0);
+        let mut st = PairState::new(fl, i, c);
+        let mut n = 0usize;
         fl.grid.for_each_run_after(xi, |run| {
-            let (s, e) = (run.start.max(i + 1), run.end);
-            if s >= e {
+            let s = run.start.max(i + 1);
+            if s >= run.end {
                 return;
             }
-            // Equal-length sub-slices: one bounds check per run instead of one per array and pair.
-            let (pos, vel) = (&fl.pos[s..e], &fl.vel[s..e]);
-            let (rho, irho, pr) = (&fl.rho[s..e], &fl.irho[s..e], &fl.pr[s..e]);
-            let (acc_o, drho_o) =
-                (&mut out.acc[s - offset..e - offset], &mut out.drho[s - offset..e - offset]);
-            for k in 0..pos.len() {
-                let dx = xi - pos[k];
-                let r2 = dx.length_squared();
-                if r2 >= c.r2max {
-                    continue;
+            for (k, p) in fl.pos[s..run.end].iter().enumerate() {
+                if n == CAP {
+                    pairs += pair_list::<K, EXTRA>(kf, c, fl, &list[..n], &mut st, offset, out, &mut batch);
+                    n = 0;
                 }
-                pairs += 1;
-                let sj = (rho[k], irho[k], pr[k]);
-                let nij = if st { ni - fl.nrm[s + k] } else { Vec3::ZERO };
-                let (a, dd_i, dd_j, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, vi - vel[k], si, sj, nij);
-                ai += a;
-                acc_o[k] -= a;
-                di += dd_i;
-                drho_o[k] += dd_j;
-                let o = s + k - offset;
-                if need_phi {
-                    let w = kf.w(r2.sqrt());
-                    phi_i += c.m * sj.1 * w;
-                    out.phi[o] += vol_i * w;
-                }
-                if need_shift {
-                    let vol_j = c.m * sj.1;
-                    gc_i += dx * (vol_j * f);
-                    out.gradc[o] -= dx * (vol_i * f);
-                    dv_i -= vol_j * r2 * f;
-                    out.divr[o] -= vol_i * r2 * f;
-                }
+                let d = xi - *p;
+                list[n] = (s + k) as u32;
+                n += (d.length_squared() < c.r2max) as usize;
             }
         });
-        let o = i - offset;
-        out.acc[o] += ai;
-        out.drho[o] += di;
-        if need_phi {
-            out.phi[o] += phi_i;
-        }
-        if need_shift {
-            out.gradc[o] += gc_i;
-            out.divr[o] += dv_i;
-        }
+        pairs += pair_list::<K, EXTRA>(kf, c, fl, &list[..n], &mut st, offset, out, &mut batch);
+        st.store(i - offset, out);
     }
     pairs
+}
+
+/// Running sums of the home particle of [`pair_block`].
+struct PairState {
+    xi: Vec3,
+    vi: Vec3,
+    si: (f64, f64, f64),
+    ni: Vec3,
+    vol_i: f64,
+    ai: Vec3,
+    di: f64,
+    phi_i: f64,
+    gc_i: Vec3,
+    dv_i: f64,
+}
+
+impl Batch {
+    fn new() -> Self {
+        Batch {
+            dx: [0.0; BATCH],
+            dy: [0.0; BATCH],
+            dz: [0.0; BATCH],
+            vx: [0.0; BATCH],
+            vy: [0.0; BATCH],
+            vz: [0.0; BATCH],
+            drho: [0.0; BATCH],
+            irj: [0.0; BATCH],
+            prj: [0.0; BATCH],
+            ax: [0.0; BATCH],
+            ay: [0.0; BATCH],
+            az: [0.0; BATCH],
+            ci: [0.0; BATCH],
+            cj: [0.0; BATCH],
+        }
+    }
+}
+
+impl PairState {
+    #[inline(always)]
+    fn new(fl: &FluidSet, i: usize, c: &Consts) -> Self {
+        let si = (fl.rho[i], fl.irho[i], fl.pr[i]);
+        PairState {
+            xi: fl.pos[i],
+            vi: fl.vel[i],
+            si,
+            ni: if c.gamma_st > 0.0 && !fl.nrm.is_empty() { fl.nrm[i] } else { Vec3::ZERO },
+            vol_i: c.m * si.1,
+            ai: Vec3::ZERO,
+            di: 0.0,
+            phi_i: 0.0,
+            gc_i: Vec3::ZERO,
+            dv_i: 0.0,
+        }
+    }
+
+    #[inline(always)]
+    fn store(&self, o: usize, out: &mut Acc) {
+        out.acc[o] += self.ai;
+        out.drho[o] += self.di;
+        if !out.phi.is_empty() {
+            out.phi[o] += self.phi_i;
+        }
+        if !out.gradc.is_empty() {
+            out.gradc[o] += self.gc_i;
+            out.divr[o] += self.dv_i;
+        }
+    }
+}
+
+/// Evaluates the pairs (home, j) for the neighbours `list` (all within the support) and applies them.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pair_list<K: KernelFn, const EXTRA: bool>(
+    kf: &K,
+    c: &Consts,
+    fl: &FluidSet,
+    list: &[u32],
+    st: &mut PairState,
+    offset: usize,
+    out: &mut Acc,
+    batch: &mut Batch,
+) -> u64 {
+    if !EXTRA {
+        if let Some((inv_h, cw)) = kf.wendland() {
+            batch_pairs(c, fl, list, st, offset, out, inv_h, cw, batch);
+            return list.len() as u64;
+        }
+    }
+    let need_phi = EXTRA && c.drag.enabled;
+    let need_shift = EXTRA && c.shift_a > 0.0;
+    let surface = EXTRA && c.gamma_st > 0.0;
+    for &j in list {
+        let j = j as usize;
+        let dx = st.xi - fl.pos[j];
+        let r2 = dx.length_squared();
+        let sj = (fl.rho[j], fl.irho[j], fl.pr[j]);
+        let nij = if surface { st.ni - fl.nrm[j] } else { Vec3::ZERO };
+        let (a, dd_i, dd_j, f) = pair_terms::<K, EXTRA>(kf, c, dx, r2, st.vi - fl.vel[j], st.si, sj, nij);
+        let o = j - offset;
+        st.ai += a;
+        out.acc[o] -= a;
+        st.di += dd_i;
+        out.drho[o] += dd_j;
+        if need_phi {
+            let w = kf.w(r2.sqrt());
+            st.phi_i += c.m * sj.1 * w;
+            out.phi[o] += st.vol_i * w;
+        }
+        if need_shift {
+            let vol_j = c.m * sj.1;
+            st.gc_i += dx * (vol_j * f);
+            out.gradc[o] -= dx * (st.vol_i * f);
+            st.dv_i -= vol_j * r2 * f;
+            out.divr[o] -= st.vol_i * r2 * f;
+        }
+    }
+    list.len() as u64
+}
+
+/// Neighbour batch of one home particle in single precision, laid out so that the pair terms compile to
+/// packed SIMD instructions.
+struct Batch {
+    dx: [f32; BATCH],
+    dy: [f32; BATCH],
+    dz: [f32; BATCH],
+    vx: [f32; BATCH],
+    vy: [f32; BATCH],
+    vz: [f32; BATCH],
+    drho: [f32; BATCH],
+    irj: [f32; BATCH],
+    prj: [f32; BATCH],
+    ax: [f32; BATCH],
+    ay: [f32; BATCH],
+    az: [f32; BATCH],
+    ci: [f32; BATCH],
+    cj: [f32; BATCH],
+}
+
+const BATCH: usize = 256;
+
+/// Pressure, viscosity, continuity and δ-SPH terms for a list of neighbours, Wendland kernel, evaluated
+/// in single precision (positions and velocities enter as differences computed in double precision; sums
+/// are kept in double precision). Same terms as [`pair_terms`] without the extras.
+#[allow(clippy::too_many_arguments)]
+fn batch_pairs(
+    c: &Consts,
+    fl: &FluidSet,
+    list: &[u32],
+    st: &mut PairState,
+    offset: usize,
+    out: &mut Acc,
+    inv_h: f64,
+    cw: f64,
+    b: &mut Batch,
+) {
+    for chunk in list.chunks(BATCH) {
+        let n = chunk.len();
+        // Gather.
+        for (t, &j) in chunk.iter().enumerate() {
+            let j = j as usize;
+            let d = st.xi - fl.pos[j];
+            let v = st.vi - fl.vel[j];
+            b.dx[t] = d.x as f32;
+            b.dy[t] = d.y as f32;
+            b.dz[t] = d.z as f32;
+            b.vx[t] = v.x as f32;
+            b.vy[t] = v.y as f32;
+            b.vz[t] = v.z as f32;
+            b.drho[t] = (st.si.0 - fl.rho[j]) as f32;
+            b.irj[t] = fl.irho[j] as f32;
+            b.prj[t] = fl.pr[j] as f32;
+        }
+        // Pair terms, vectorised.
+        let (inv_h, cw, h) = (inv_h as f32, cw as f32, c.h as f32);
+        let (eta2, av, m, nu, dc) = (c.eta2 as f32, c.av as f32, c.m as f32, c.nu as f32, c.dc as f32);
+        let (gx, gy, gz) = (c.gk.x as f32, c.gk.y as f32, c.gk.z as f32);
+        let (iri, pri) = (st.si.1 as f32, st.si.2 as f32);
+        for t in 0..n.min(BATCH) {
+            let (dx, dy, dz) = (b.dx[t], b.dy[t], b.dz[t]);
+            let (vx, vy, vz) = (b.vx[t], b.vy[t], b.vz[t]);
+            let r2 = dx * dx + dy * dy + dz * dz;
+            let r = r2.sqrt();
+            let q = 1.0 - 0.5 * r * inv_h;
+            let f = cw * q * q * q;
+            let inv_d = 1.0 / (r2 + eta2);
+            let vr = vx * dx + vy * dy + vz * dz;
+            let irj = b.irj[t];
+            let mu = h * vr.min(0.0) * inv_d;
+            let s = -(pri + b.prj[t]) + av * mu * (iri + irj);
+            let ms = m * s * f;
+            let lam = m * nu * (iri + irj) * r2 * f * inv_d;
+            b.ax[t] = dx * ms + vx * lam;
+            b.ay[t] = dy * ms + vy * lam;
+            b.az[t] = dz * ms + vz * lam;
+            let cont = m * vr * f;
+            let psi = dc * (b.drho[t] - (gx * dx + gy * dy + gz * dz)) * f * m;
+            b.ci[t] = cont + psi * irj;
+            b.cj[t] = cont - psi * iri;
+        }
+        // Scatter.
+        for (t, &j) in chunk.iter().enumerate() {
+            let o = j as usize - offset;
+            let a = Vec3::new(b.ax[t] as f64, b.ay[t] as f64, b.az[t] as f64);
+            st.ai += a;
+            out.acc[o] -= a;
+            st.di += b.ci[t] as f64;
+            out.drho[o] += b.cj[t] as f64;
+        }
+    }
+}
+
+/// Buffers of the batched wall interactions.
+struct WallScratch {
+    list: [u32; BATCH],
+    batch: Batch,
+}
+
+/// Wall interactions of one fluid particle, Wendland kernel, without extras: neighbours collected without
+/// branching, then pressure, viscosity and continuity evaluated in single precision (as [`wall_pair`]).
+/// Returns the acceleration, density rate, part mask and number of wall neighbours.
+#[allow(clippy::too_many_arguments)]
+fn walls_batched(
+    c: &Consts,
+    wl: &WallSet,
+    xi: Vec3,
+    vi: Vec3,
+    si: (f64, f64, f64),
+    inv_h: f64,
+    cw: f64,
+    sc: &mut WallScratch,
+) -> (Vec3, f64, u32, u64) {
+    let mut acc = Vec3::ZERO;
+    let mut d = 0.0;
+    let mut near = 0u32;
+    let mut count = 0u64;
+    let mut n = 0usize;
+    let flush = |list: &[u32], b: &mut Batch, acc: &mut Vec3, d: &mut f64, near: &mut u32| {
+        for (t, &j) in list.iter().enumerate() {
+            let j = j as usize;
+            let dx = xi - wl.pos[j];
+            let vw = vi - wl.vel[j];
+            let vv = vi - wl.vvisc[j];
+            b.dx[t] = dx.x as f32;
+            b.dy[t] = dx.y as f32;
+            b.dz[t] = dx.z as f32;
+            b.vx[t] = vw.x as f32;
+            b.vy[t] = vw.y as f32;
+            b.vz[t] = vw.z as f32;
+            // Reuse the remaining lanes: dummy-velocity difference and wall mass.
+            b.ax[t] = vv.x as f32;
+            b.ay[t] = vv.y as f32;
+            b.az[t] = vv.z as f32;
+            b.drho[t] = (wl.rho[j] * wl.vol[j]) as f32;
+            b.irj[t] = wl.irho[j] as f32;
+            b.prj[t] = wl.pr[j] as f32;
+            let part = wl.part[j] as u32;
+            *near |= if part < 31 { 1 << part } else { 1 << 31 };
+        }
+        let (inv_h, cw, h) = (inv_h as f32, cw as f32, c.h as f32);
+        let (eta2, av, nu) = (c.eta2 as f32, c.av as f32, c.nu as f32);
+        let (iri, pri) = (si.1 as f32, si.2 as f32);
+        let m = list.len();
+        for t in 0..m.min(BATCH) {
+            let (dx, dy, dz) = (b.dx[t], b.dy[t], b.dz[t]);
+            let r2 = dx * dx + dy * dy + dz * dz;
+            let r = r2.sqrt();
+            let q = 1.0 - 0.5 * r * inv_h;
+            let f = cw * q * q * q;
+            let inv_d = 1.0 / (r2 + eta2);
+            let vr = b.vx[t] * dx + b.vy[t] * dy + b.vz[t] * dz;
+            let irb = b.irj[t];
+            let mb = b.drho[t];
+            let mu = h * vr.min(0.0) * inv_d;
+            let s = -(pri + b.prj[t]) + av * mu * (iri + irb);
+            let ms = mb * s * f;
+            let lam = mb * nu * (iri + irb) * r2 * f * inv_d;
+            b.vx[t] = dx * ms + b.ax[t] * lam;
+            b.vy[t] = dy * ms + b.ay[t] * lam;
+            b.vz[t] = dz * ms + b.az[t] * lam;
+            b.ci[t] = mb * vr * f;
+        }
+        for t in 0..m.min(BATCH) {
+            *acc += Vec3::new(b.vx[t] as f64, b.vy[t] as f64, b.vz[t] as f64);
+            *d += b.ci[t] as f64;
+        }
+    };
+    let WallScratch { list, batch } = sc;
+    wl.grid.for_each_run(xi, |run| {
+        for (k, p) in wl.pos[run.clone()].iter().enumerate() {
+            if n == BATCH {
+                flush(&list[..n], batch, &mut acc, &mut d, &mut near);
+                count += n as u64;
+                n = 0;
+            }
+            list[n] = (run.start + k) as u32;
+            n += ((xi - *p).length_squared() < c.r2max) as usize;
+        }
+    });
+    flush(&list[..n], batch, &mut acc, &mut d, &mut near);
+    count += n as u64;
+    (acc, d, near, count)
 }
 
 struct ParticleResult {
@@ -622,6 +907,7 @@ fn finish_particle<K: KernelFn, const EXTRA: bool>(
     phi_pairs: &[f64],
     gradc_pairs: &[Vec3],
     divr_pairs: &[f64],
+    scratch: &mut WallScratch,
 ) -> ParticleResult {
     let xi = fl.pos[i];
     let vi = fl.vel[i];
@@ -659,6 +945,17 @@ fn finish_particle<K: KernelFn, const EXTRA: bool>(
         }
     });
     let mut near = 0u32;
+    if !EXTRA {
+        if let Some((inv_h, cw)) = kf.wendland() {
+            let (a, dd, nr, cnt) = walls_batched(c, wl, xi, vi, si, inv_h, cw, scratch);
+            acc += a;
+            d += dd;
+            near = nr;
+            n_int += cnt;
+            acc += c.g;
+            return ParticleResult { acc, drho: d, near, shift: Vec3::ZERO, interactions: n_int };
+        }
+    }
     wl.grid.for_each_run(xi, |run| {
         for b in run {
             let dx = xi - wl.pos[b];
