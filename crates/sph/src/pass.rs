@@ -319,12 +319,10 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     let mut acc = dx * (mb * s * f);
     let d = mb * vr * f;
     acc += (vi - wl.vvisc[b]) * (mb * c.nu * (irhoi + irhob) * r2 * f * inv_d);
-    if EXTRA {
-        if c.gamma_st > 0.0 && r > 0.0 {
-            let beta = c.beta[wl.part[b] as usize];
-            if beta != 0.0 {
-                acc -= dx * (beta * c.rho0 * wl.vol[b] * akinci_adhesion(r, c.support) / r);
-            }
+    if EXTRA && c.gamma_st > 0.0 && r > 0.0 {
+        let beta = c.beta[wl.part[b] as usize];
+        if beta != 0.0 {
+            acc -= dx * (beta * c.rho0 * wl.vol[b] * akinci_adhesion(r, c.support) / r);
         }
     }
     (acc, d)
@@ -415,13 +413,11 @@ fn pair_terms<K: KernelFn, const EXTRA: bool>(
         dj -= psi * irhoi;
     }
     a += vij * (c.m * c.nu * (irhoi + irhoj) * r2 * f * inv_d);
-    if EXTRA {
-        if c.gamma_st > 0.0 && r > 0.0 {
-            let kij = 2.0 * c.rho0 / (rhoi + rhoj);
-            let coh = akinci_cohesion(r, c.support);
-            a -= dx * (c.gamma_st * kij * c.m * coh / r);
-            a -= nij * (c.gamma_st * kij * c.curv);
-        }
+    if EXTRA && c.gamma_st > 0.0 && r > 0.0 {
+        let kij = 2.0 * c.rho0 / (rhoi + rhoj);
+        let coh = akinci_cohesion(r, c.support);
+        a -= dx * (c.gamma_st * kij * c.m * coh / r);
+        a -= nij * (c.gamma_st * kij * c.curv);
     }
     (a, di, dj, f)
 }
