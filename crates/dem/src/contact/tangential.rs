@@ -86,8 +86,16 @@ fn spring_history(
     let cap = mu * f_coulomb;
     let f2 = f.length_squared();
     if f2 > cap * cap {
-        f = if f2 > 0.0 { f * (cap / f2.sqrt()) } else { Vec3::ZERO };
-        x = if k_t > 0.0 { -f / k_t } else { Vec3::ZERO };
+        // F ← μF_c F/|F|, ξ ← −F/k_t, with one square root and one division.
+        let len = f2.sqrt();
+        if k_t > 0.0 {
+            let t = 1.0 / (len * k_t);
+            x = f * (-cap * t);
+            f *= cap * k_t * t;
+        } else {
+            f *= cap / len;
+            x = Vec3::ZERO;
+        }
     }
     *xi = x;
     *k_prev = k_t;

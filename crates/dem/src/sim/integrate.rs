@@ -44,6 +44,8 @@ impl<L: ContactLaw> Simulation<L> {
             .map(|(c, (((vs, ws), xs), (fs, ts)))| {
                 let base = c * CHUNK;
                 let mut m: f64 = 0.0;
+                // Sum of squares: NaN or ∞ anywhere propagates to it (f64::max would hide a NaN).
+                let mut check = 0.0;
                 for (k, ((v, w), x)) in vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut()).enumerate() {
                     let i = base + k;
                     // Frozen particles have zero inverse mass and inertia: the kick vanishes.
@@ -52,7 +54,9 @@ impl<L: ContactLaw> Simulation<L> {
                     if drift {
                         *x += *v * dt;
                     }
-                    m = m.max(v.length_squared());
+                    let v2 = v.length_squared();
+                    m = m.max(v2);
+                    check += v2 + w.length_squared() + x.length_squared();
                     if reset {
                         fs[k] = if inv_m[i] > 0.0 { mass[i] * g } else { Vec3::ZERO };
                         ts[k] = Vec3::ZERO;
@@ -62,15 +66,20 @@ impl<L: ContactLaw> Simulation<L> {
                         }
                     }
                 }
-                m
+                (m, check)
             })
-            .reduce(|| 0.0, f64::max);
+            .reduce(|| (0.0, 0.0), |a, b| (a.0.max(b.0), a.1 + b.1));
         self.base_forces_ready = reset;
-        v2max.sqrt()
+        self.state_maybe_nonfinite |= !v2max.1.is_finite();
+        v2max.0.sqrt()
     }
 
-    /// Fails with a blow-up error naming the first particle whose state is not finite.
-    pub(crate) fn check_finite(&self) -> Result<(), DemError> {
+    /// Fails with a blow-up error naming the first particle whose state is not finite (the kicks flag a
+    /// non-finite state as they go; only then are the particles searched).
+    pub(crate) fn check_finite(&mut self) -> Result<(), DemError> {
+        if !std::mem::take(&mut self.state_maybe_nonfinite) {
+            return Ok(());
+        }
         let p = &self.particles;
         let bad = (0..p.len())
             .into_par_iter()

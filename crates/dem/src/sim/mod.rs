@@ -225,6 +225,8 @@ pub struct Simulation<L: ContactLaw> {
     last_worst: (u32, u32),
     /// The force arrays already hold gravity and external forces for the next evaluation.
     base_forces_ready: bool,
+    /// A kick met a non-finite velocity, angular velocity or position.
+    state_maybe_nonfinite: bool,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -254,6 +256,7 @@ impl<L: ContactLaw> Simulation<L> {
             external: None,
             last_worst: (0, 0),
             base_forces_ready: false,
+            state_maybe_nonfinite: false,
         }
     }
 

@@ -146,9 +146,17 @@ impl<L: ContactLaw> Simulation<L> {
             })
             .collect();
         let list = &mut self.st.list;
+        let total: usize = parts.iter().map(|p| p.1.len()).sum();
         list.start.clear();
+        list.start.reserve_exact(n + 1);
         list.start.push(0);
         list.nbr.clear();
+        // Exact capacities (no growth slack), shrunk when the list got much shorter.
+        if list.nbr.capacity() > total + total / 4 + 64 {
+            list.nbr.shrink_to(total);
+            list.state.shrink_to(total);
+        }
+        list.nbr.reserve_exact(total);
         let mut span = 1usize;
         for (counts, nb) in &parts {
             let mut k = 0usize;
@@ -168,6 +176,7 @@ impl<L: ContactLaw> Simulation<L> {
 
         // 5. Restore pair states.
         list.state.clear();
+        list.state.reserve_exact(list.nbr.len());
         list.state.resize(list.nbr.len(), default);
         if !carry.is_empty() {
             let reach = range_pp;

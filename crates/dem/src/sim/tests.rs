@@ -182,3 +182,47 @@ fn settled_pile_rests_and_the_floor_carries_its_weight() {
     assert!(e.rotational < 1e-5 * (pe0 - e.potential), "still spinning: {e:?}");
     assert!((-f.z / weight - 1.0).abs() < 0.01, "floor force {} N vs weight {weight} N", -f.z);
 }
+
+#[test]
+fn blow_ups_name_the_particle_the_step_and_the_cause() {
+    // Two spheres created overlapping by half a radius: stopped at once, the cause says so.
+    let mats = vec![soft()];
+    let mut sim = Simulation::new(
+        HertzMindlin::default(),
+        mats.clone(),
+        uniform_pairs(&mats, 0.5, 0.5),
+        1e-6,
+        Settings::default(),
+    );
+    sim.add_particle(crate::NewParticle::at(Vec3::ZERO, 0.01, 0));
+    let b = sim.add_particle(crate::NewParticle::at(Vec3::new(0.015, 0.0, 0.0), 0.01, 0));
+    match sim.step() {
+        Err(crate::DemError::BlowUp { particle, step, what, cause, .. }) => {
+            assert!(particle == 0 || particle == b);
+            assert_eq!(step, 0);
+            assert!(what.contains("overlap") && what.contains(&format!("id {}", 1 - particle)), "{what}");
+            assert!(cause.contains("overlapping"), "{cause}");
+        }
+        other => panic!("expected a blow-up, got {other:?}"),
+    }
+    // A time step of 5 Rayleigh times: a fast impact on the floor overshoots; the message blames dt.
+    let mut sim = Simulation::new(
+        HertzMindlin::default(),
+        mats.clone(),
+        uniform_pairs(&mats, 0.5, 0.5),
+        1.0,
+        Settings::default(),
+    );
+    let mut p = crate::NewParticle::at(Vec3::new(0.0, 0.0, 0.0105), 0.01, 0);
+    p.vel = Vec3::new(0.0, 0.0, -5.0);
+    sim.add_particle(p);
+    sim.dt = 5.0 * sim.rayleigh_time();
+    sim.add_wall(Wall {
+        name: "floor".into(),
+        shape: WallShape::Plane(Plane::new(Vec3::ZERO, Vec3::Z)),
+        material: 0,
+        motion: Motion::Fixed,
+    });
+    let err = sim.run_steps(1000).unwrap_err().to_string();
+    assert!(err.contains("particle id 0") && err.contains("Rayleigh") && err.contains("step"), "{err}");
+}
