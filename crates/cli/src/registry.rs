@@ -8,7 +8,7 @@ pub const DEMO_SCENARIO: (&str, &str) =
     ("examples/snow_regime_map.toml", include_str!("../../../examples/snow_regime_map.toml"));
 
 /// Names accepted by `spatter bench`.
-pub const BENCHES: &[&str] = &["snow", "track"];
+pub const BENCHES: &[&str] = &["dem", "sph", "snow", "track"];
 
 /// Every registered validation case, engine by engine.
 pub fn validation_cases() -> Vec<Case> {
@@ -22,6 +22,8 @@ pub fn validation_cases() -> Vec<Case> {
 /// Runs benchmark `name` and returns the lines to print.
 pub fn run_bench(name: &str, quick: bool) -> anyhow::Result<Vec<String>> {
     match name {
+        "dem" => Ok(spatter_dem::bench::bench(quick)?),
+        "sph" => Ok(spatter_sph::bench::bench(quick)?),
         "snow" => Ok(spatter_workflows::snow::bench(quick)?),
         "track" => Ok(spatter_flow::bench::bench(quick)?),
         _ => anyhow::bail!("no benchmark named `{name}`; expected one of: {}", BENCHES.join(", ")),
