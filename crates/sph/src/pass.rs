@@ -19,7 +19,7 @@
 //! enter the same pressure, artificial-viscosity and continuity terms with the wall velocity, the laminar
 //! term with the no-slip dummy velocity, and the Akinci adhesion force.
 
-use crate::kernel::{akinci_adhesion, akinci_cohesion, Dim, Kernel, KernelKind};
+use crate::kernel::{AkinciSplines, Dim, Kernel, KernelKind};
 use crate::neighbours::NeighbourGrid;
 use crate::params::DragParams;
 use rayon::prelude::*;
@@ -162,6 +162,7 @@ pub(crate) struct Consts {
     pub eos_b: f64,
     pub eos_gamma: f64,
     pub eos: crate::eos::Tait,
+    pub akinci: AkinciSplines,
     pub wet_d2: f64,
     pub slip_free: Vec<bool>,
 }
@@ -282,7 +283,8 @@ pub(crate) fn wall_state(
                     } else {
                         (0.0, wl.vel[b])
                     };
-                    let rho = c.rho0 * (p / c.eos_b + 1.0).powf(1.0 / c.eos_gamma);
+                    let rho =
+                        if p > 0.0 { c.rho0 * (p / c.eos_b + 1.0).powf(1.0 / c.eos_gamma) } else { c.rho0 };
                     rho_c[o] = rho;
                     pr_c[o] = p / (rho * rho);
                     ir_c[o] = 1.0 / rho;
@@ -322,7 +324,7 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     if EXTRA && c.gamma_st > 0.0 && r > 0.0 {
         let beta = c.beta[wl.part[b] as usize];
         if beta != 0.0 {
-            acc -= dx * (beta * c.rho0 * wl.vol[b] * akinci_adhesion(r, c.support) / r);
+            acc -= dx * (beta * c.rho0 * wl.vol[b] * c.akinci.adhesion(r) / r);
         }
     }
     (acc, d)
@@ -415,7 +417,7 @@ fn pair_terms<K: KernelFn, const EXTRA: bool>(
     a += vij * (c.m * c.nu * (irhoi + irhoj) * r2 * f * inv_d);
     if EXTRA && c.gamma_st > 0.0 && r > 0.0 {
         let kij = 2.0 * c.rho0 / (rhoi + rhoj);
-        let coh = akinci_cohesion(r, c.support);
+        let coh = c.akinci.cohesion(r);
         a -= dx * (c.gamma_st * kij * c.m * coh / r);
         a -= nij * (c.gamma_st * kij * c.curv);
     }

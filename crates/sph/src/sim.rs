@@ -432,6 +432,7 @@ impl Simulation {
             eos_b: eos.stiffness(),
             eos_gamma: p.gamma,
             eos,
+            akinci: crate::kernel::AkinciSplines::new(support),
             wet_d2: p.wet_distance * p.wet_distance,
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }
