@@ -127,3 +127,16 @@ fn shipped_examples_are_valid() {
         Checker::run(&cfg, Some(&root)).unwrap_or_else(|e| panic!("{name}: {e:?}"));
     }
 }
+
+#[test]
+fn the_resolved_configuration_round_trips_through_toml() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(root.join("sph_wheel.toml")).unwrap();
+    let body: String =
+        text.lines().filter(|l| !l.trim_start().starts_with("kind")).collect::<Vec<_>>().join("\n");
+    let cfg: SphConfig = toml::from_str(&body).unwrap();
+    let resolved = toml::to_string(&cfg).expect("serialises");
+    let back: SphConfig = toml::from_str(&resolved).expect("parses back");
+    assert_eq!(back, cfg);
+    assert!(resolved.contains("artificial_viscosity = 0.02"), "defaults are written out:\n{resolved}");
+}

@@ -297,7 +297,12 @@ impl ImportedField {
             }
         }
         let k = if eps.is_empty() { Vec::new() } else { k };
-        Ok(Frame { time, u, k, eps })
+        if self.mode == Interpolation::Cell {
+            return Ok(Frame { time, u, k, eps });
+        }
+        // Point values follow the mesh's own (Morton) point order.
+        let m = &self.mesh;
+        Ok(Frame { time, u: m.permute_points(&u), k: m.permute_points(&k), eps: m.permute_points(&eps) })
     }
 
     /// Number of time levels.

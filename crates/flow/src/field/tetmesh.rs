@@ -41,6 +41,9 @@ pub struct TetMesh {
     pub neighbours: Vec<[u32; 4]>,
     /// Source cell of each tetrahedron.
     pub tet_cell: Vec<u32>,
+    /// `points[i]` is point `point_order[i]` of the list given to [`TetMesh::new`] (points are stored in
+    /// Morton order too); per-point data must be permuted the same way.
+    pub point_order: Vec<u32>,
     grid: BinGrid,
 }
 
@@ -105,10 +108,34 @@ impl TetMesh {
         order.sort_unstable();
         tets = order.iter().map(|&(_, i)| tets[i as usize]).collect();
         tet_cell = order.iter().map(|&(_, i)| tet_cell[i as usize]).collect();
+        // Points in Morton order as well, so a tetrahedron's corners lie close in memory.
+        let pkey = |p: &Vec3| {
+            let r = ((*p - bounds.min) / ext).clamp(Vec3::ZERO, Vec3::ONE) * 1_048_575.0;
+            morton3(r.x as u64, r.y as u64, r.z as u64)
+        };
+        let mut porder: Vec<(u64, u32)> =
+            points.iter().enumerate().map(|(i, p)| (pkey(p), i as u32)).collect();
+        porder.sort_unstable();
+        let point_order: Vec<u32> = porder.iter().map(|&(_, i)| i).collect();
+        let mut new_index = vec![0u32; points.len()];
+        for (new, &old) in point_order.iter().enumerate() {
+            new_index[old as usize] = new as u32;
+        }
+        let points: Vec<Vec3> = point_order.iter().map(|&i| points[i as usize]).collect();
+        tets.iter_mut().for_each(|t| *t = t.map(|i| new_index[i as usize]));
         let neighbours = build_neighbours(&tets);
-        let mut m = TetMesh { points, tets, neighbours, tet_cell, grid: BinGrid::default() };
+        let mut m = TetMesh { points, tets, neighbours, tet_cell, point_order, grid: BinGrid::default() };
         m.grid = m.build_grid();
         m
+    }
+
+    /// Reorders per-point values given in the order of the points passed to [`TetMesh::new`] (an empty
+    /// list stays empty).
+    pub fn permute_points<T: Copy>(&self, values: &[T]) -> Vec<T> {
+        if values.is_empty() {
+            return Vec::new();
+        }
+        self.point_order.iter().map(|&i| values[i as usize]).collect()
     }
 
     pub fn bounds(&self) -> Aabb {
