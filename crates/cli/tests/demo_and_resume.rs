@@ -25,6 +25,16 @@ fn demo_writes_a_complete_run_folder() {
     for must in ["run.toml", "log.txt", "impacts.csv", "regime_map.png", "regime_map.json"] {
         assert!(names.iter().any(|n| n == must), "{must} missing from {names:?}");
     }
+    // ParaView series of the sample impacts: a .pvd whose every file exists and reads back.
+    let pvd = std::fs::read_to_string(out.join("samples/bounce.pvd")).unwrap();
+    let frames: Vec<&str> =
+        pvd.lines().filter_map(|l| l.split("file=\"").nth(1)?.split('"').next()).collect();
+    assert!(frames.len() > 10, "{pvd}");
+    for f in &frames {
+        let d = spatter_io::vtu::read(&out.join("samples").join(f)).unwrap();
+        assert_eq!(d.points.len(), 1);
+    }
+    spatter_io::vtu::read(&out.join("samples/wall.vtu")).unwrap();
     // The resolved input is itself a valid scenario.
     let (code, err) = check(&out.join("run.toml"));
     assert_eq!(code, 0, "run.toml does not check: {err}");

@@ -10,6 +10,7 @@ pub mod model;
 pub mod output;
 pub mod regime;
 pub mod runner;
+pub mod samples;
 
 pub use config::SnowConfig;
 pub use runner::{run, SnowError};

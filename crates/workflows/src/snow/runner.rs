@@ -298,6 +298,13 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
                     .push("no stick/bounce interface inside the grid: no regime_map.json written".into());
             }
         }
+        if ai == 0 && *angle == 0.0 {
+            // The two impacts either side of the boundary at the smallest diameter, for ParaView.
+            if let Some(b) = iface.brackets.first() {
+                let picks = [(b[0], b[1], "stick"), (b[0], b[2], "bounce")];
+                s.artifacts.extend(super::samples::write_sample_impacts(&model, &picks, ctx.dir)?);
+            }
+        }
         let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
         let chart = output::regime_chart(&title, recs, &points, map.as_ref().map(|m| &m.v_crit_of_d), &axes);
         let png = output::save_chart(&chart, ctx.dir, &format!("regime_map{suffix}"), cfg.svg)?;
