@@ -19,7 +19,8 @@ Examples:
   spatter run study.toml --out runs/a --resume   # continue after Ctrl-C
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
-  spatter bench dem                              # throughput of an engine";
+  spatter bench dem                              # throughput of an engine
+  spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV";
 
 #[derive(Parser, Debug)]
 #[command(name = "spatter", version, about = "Particles that hit, stick to, wet and wear surfaces.", after_help = EXAMPLES)]
@@ -73,6 +74,15 @@ enum Command {
         #[arg(long)]
         case: Option<String>,
     },
+    /// Rank the particle–fluid forces of a `forces` scenario: table on screen, CSV in the output folder.
+    #[command(after_help = "Example:\n  spatter forces examples/forces_table_6_4.toml --out runs/forces")]
+    Forces {
+        /// Scenario file of kind `forces`.
+        scenario: PathBuf,
+        /// Output folder for the CSV tables [default: runs/<scenario file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run a named benchmark and print its throughput.
     #[command(after_help = "Example:\n  spatter bench dem\n  spatter bench snow --quick")]
     Bench {
@@ -95,6 +105,7 @@ fn main() -> ExitCode {
         Command::Demo { out, threads } => commands::run::demo(&out, threads),
         Command::Validate { quick, case } => commands::validate(quick, case.as_deref()),
         Command::Bench { engine, quick } => commands::bench(&engine, quick),
+        Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
     };
     match result {
         Ok(code) => code,

@@ -79,6 +79,27 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
+/// `spatter forces <scenario>`: a `forces` run, which prints the ranking table and writes it as CSV.
+pub fn forces(path: &Path, out: Option<&Path>) -> Result<ExitCode> {
+    let loaded = match spatter_scenario::load(path) {
+        Ok(l) => l,
+        Err(errors) => {
+            report_errors(&errors);
+            return Ok(ExitCode::from(EXIT_BAD_INPUT));
+        }
+    };
+    let spatter_scenario::Scenario::Forces(_) = &loaded.scenario else {
+        eprintln!(
+            "error: {}: `spatter forces` needs a scenario of kind \"forces\", this one is \"{}\" (use `spatter run`)",
+            path.display(),
+            loaded.scenario.kind()
+        );
+        return Ok(ExitCode::from(EXIT_BAD_INPUT));
+    };
+    // The run prints the ranking table (its headline) and writes the CSV tables.
+    run::run_file(path, out, None, false)
+}
+
 /// `spatter bench <engine>`.
 pub fn bench(engine: &str, quick: bool) -> Result<ExitCode> {
     for line in registry::run_bench(engine, quick)? {
