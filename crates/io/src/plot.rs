@@ -276,6 +276,21 @@ impl Chart {
     }
 }
 
+/// Splits `text` into lines of at most `width` characters at spaces (a longer word gets a line of its own).
+fn wrap_words(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split_whitespace() {
+        match lines.last_mut() {
+            Some(l) if l.chars().count() + 1 + word.chars().count() <= width => {
+                l.push(' ');
+                l.push_str(word);
+            }
+            _ => lines.push(word.to_owned()),
+        }
+    }
+    lines
+}
+
 /// Perceptually uniform colour map (viridis, sampled at nine stops and interpolated linearly).
 pub fn viridis(t: f64) -> (u8, u8, u8) {
     const STOPS: [(f64, f64, f64); 9] = [
@@ -396,8 +411,13 @@ pub fn mesh_map_png(
         let label = tick_label(vmin + f * (vmax - vmin));
         bar.draw(&Text::new(label, (50, y - 7), ("sans-serif", 13))).map_err(|x| err(path, x))?;
     }
-    bar.draw(&Text::new(colorbar_label.to_owned(), (5, bar_top - 40), ("sans-serif", 14)))
-        .map_err(|x| err(path, x))?;
+    // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
+    let lines = wrap_words(colorbar_label, 20);
+    let first = bar_top - 12 - 16 * lines.len() as i32;
+    for (k, line) in lines.iter().enumerate() {
+        bar.draw(&Text::new(line.clone(), (5, first + 16 * k as i32), ("sans-serif", 14)))
+            .map_err(|x| err(path, x))?;
+    }
     root.present().map_err(|x| err(path, x))
 }
 
@@ -425,6 +445,15 @@ mod tests {
         assert_eq!(png_size(&dir.path().join("a.png")), (900, 650));
         let svg = std::fs::read_to_string(dir.path().join("a.svg")).unwrap();
         assert!(svg.contains("power law"));
+    }
+
+    #[test]
+    fn colour_bar_labels_wrap() {
+        assert_eq!(
+            wrap_words("deposited mass per area [kg/m²]", 20),
+            vec!["deposited mass per", "area [kg/m²]"]
+        );
+        assert_eq!(wrap_words("x", 20), vec!["x"]);
     }
 
     #[test]
