@@ -9,11 +9,14 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let flag = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let quick = args.iter().any(|a| a == "--quick");
+    let energy = !args.iter().any(|a| a == "--no-energy");
     if let Some(path) = flag("--lammps-data") {
         // Settle, export for LAMMPS, and time the same state here.
         let case = if quick { BoxCase::quick() } else { BoxCase::full() };
         let steps: u64 = flag("--steps").map(|s| s.parse().expect("--steps N")).unwrap_or(1000);
-        let settle_steps: u64 = flag("--settle").map(|s| s.parse().expect("--settle N")).unwrap_or(600);
+        let settle_steps: u64 = flag("--settle")
+            .map(|s| s.parse().expect("--settle N"))
+            .unwrap_or(if quick { 2000 } else { 4000 });
         let mut sim = dense_box(&case);
         settle(&mut sim, settle_steps).expect("settling");
         write_lammps_data(&sim, case.extent(), std::path::Path::new(&path)).expect("data file");
@@ -24,14 +27,40 @@ fn main() {
         println!("particles {}", sim.particles.len());
         println!("dt {:e}", case.dt);
         println!("pair_contacts {}", sim.last_evaluation().pair_contacts);
+        let e = sim.energy();
+        println!("kinetic_over_elastic {:.3e}", (e.kinetic + e.rotational) / e.elastic.max(1e-300));
         println!("bytes_per_particle {:.0}", sim.bytes_per_particle());
         let state = sim.state();
+        if let Some(chunks) = flag("--chunks") {
+            // Noisy machines: the fastest of many short chunks approximates the uncontended speed.
+            let chunks: usize = chunks.parse().expect("--chunks N");
+            let chunk_steps: u64 =
+                flag("--chunk-steps").map(|s| s.parse().expect("--chunk-steps N")).unwrap_or(10);
+            let t: usize = flag("--threads-only").map(|s| s.parse().expect("--threads-only N")).unwrap_or(1);
+            let mut run = dense_box(&case);
+            run.restore(state).expect("restore");
+            run.law.energy = energy;
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().expect("pool");
+            let mut best = f64::INFINITY;
+            pool.install(|| {
+                for _ in 0..chunks {
+                    let t0 = std::time::Instant::now();
+                    run.run_steps(chunk_steps).expect("steps");
+                    best = best.min(t0.elapsed().as_secs_f64() / chunk_steps as f64);
+                }
+            });
+            println!(
+                "spatter_threads_{t}_best_chunk {:.6e} particle-steps/s",
+                run.particles.len() as f64 / best
+            );
+            return;
+        }
         let threads: Vec<usize> = match flag("--threads-only") {
             Some(t) => vec![t.parse().expect("--threads-only N")],
             None => vec![1, 2],
         };
         for t in threads {
-            let r = time_run(&case, &state, t, steps, true).expect("timed run");
+            let r = time_run(&case, &state, t, steps, true, energy).expect("timed run");
             println!(
                 "spatter_threads_{t} {:.6e} particle-steps/s ({} steps, {:.3} s, {} rebuilds)",
                 r.rate(),

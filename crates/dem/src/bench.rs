@@ -208,9 +208,11 @@ pub fn time_run(
     threads: usize,
     steps: u64,
     verlet_list: bool,
+    energy: bool,
 ) -> Result<Timing, DemError> {
     let mut sim = dense_box(case);
     sim.settings.verlet_list = verlet_list;
+    sim.law.energy = energy;
     sim.restore(state.clone()).map_err(DemError::Resume)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -226,7 +228,7 @@ pub fn time_run(
 /// Runs the benchmark and returns the lines to print. `quick` uses the reduced box and fewer steps.
 pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
     let case = if quick { BoxCase::quick() } else { BoxCase::full() };
-    let (settle_steps, steps) = if quick { (200, 100) } else { (600, 400) };
+    let (settle_steps, steps) = if quick { (2000, 200) } else { (4000, 400) };
     let mut lines = Vec::new();
     let t = Instant::now();
     let mut sim = dense_box(&case);
@@ -249,8 +251,8 @@ pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
         sim.last_evaluation().wall_contacts,
         sim.pair_list_len()
     ));
-    let one = time_run(&case, &state, 1, steps, true)?;
-    let two = time_run(&case, &state, 2, steps, true)?;
+    let one = time_run(&case, &state, 1, steps, true, true)?;
+    let two = time_run(&case, &state, 2, steps, true, true)?;
     lines.push(format!(
         "  1 thread : {:.3e} particle-steps/s ({} steps in {:.2} s, {} list rebuilds)",
         one.rate(),
@@ -267,8 +269,14 @@ pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
         50.0 * two.rate() / one.rate()
     ));
     let no_list_steps = (steps / 4).max(10);
-    let nl = time_run(&case, &state, 1, no_list_steps, false)?;
-    let wl = time_run(&case, &state, 1, no_list_steps, true)?;
+    let ne = time_run(&case, &state, 1, steps, true, false)?;
+    lines.push(format!(
+        "  1 thread without per-contact energy bookkeeping: {:.3e} particle-steps/s ({:.2}x)",
+        ne.rate(),
+        ne.rate() / one.rate()
+    ));
+    let nl = time_run(&case, &state, 1, no_list_steps, false, true)?;
+    let wl = time_run(&case, &state, 1, no_list_steps, true, true)?;
     lines.push(format!(
         "  neighbour search, 1 thread, {} steps: Verlet list {:.3e} particle-steps/s, cell search every step {:.3e} \
          (list is {:.2}x faster)",

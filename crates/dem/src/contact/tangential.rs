@@ -28,7 +28,8 @@ pub trait TangentialLaw: Clone + Debug + Send + Sync + 'static {
     fn stiffness(&self, p: &Self::Params, nf: &NormalForce, c: &ContactInput) -> f64;
 
     /// The tangential force for tangential relative velocity `v_t` \[m/s\], dashpot `gamma_t` \[N s/m\] and
-    /// Coulomb normal force `f_coulomb` ≥ 0 \[N\]; updates the history in `state`.
+    /// Coulomb normal force `f_coulomb` ≥ 0 \[N\]; updates the history in `state`. With `energy` false the
+    /// returned energy and dissipation may be left zero.
     #[allow(clippy::too_many_arguments)]
     fn force(
         &self,
@@ -39,6 +40,7 @@ pub trait TangentialLaw: Clone + Debug + Send + Sync + 'static {
         f_coulomb: f64,
         v_t: Vec3,
         c: &ContactInput,
+        energy: bool,
     ) -> TangentialForce;
 }
 
@@ -65,6 +67,7 @@ fn spring_history(
     v_t: Vec3,
     n: Vec3,
     dt: f64,
+    track_energy: bool,
 ) -> TangentialForce {
     let len2 = xi.length_squared();
     let mut x = *xi;
@@ -99,6 +102,9 @@ fn spring_history(
     }
     *xi = x;
     *k_prev = k_t;
+    if !track_energy {
+        return TangentialForce { force: f, dissipated: 0.0, energy: 0.0 };
+    }
     let energy = 0.5 * k_t * x.length_squared();
     // Energy absorbed by the contact in this step minus the change of stored spring energy. A spring whose
     // stiffness changes with the normal load (Mindlin) changes its stored energy without work; that change
@@ -153,8 +159,9 @@ impl TangentialLaw for Mindlin {
         f_coulomb: f64,
         v_t: Vec3,
         c: &ContactInput,
+        energy: bool,
     ) -> TangentialForce {
-        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
+        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt, energy)
     }
 }
 
@@ -194,8 +201,9 @@ impl TangentialLaw for LinearHistory {
         f_coulomb: f64,
         v_t: Vec3,
         c: &ContactInput,
+        energy: bool,
     ) -> TangentialForce {
-        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt)
+        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt, energy)
     }
 }
 
@@ -224,6 +232,7 @@ impl TangentialLaw for Frictionless {
         _f_coulomb: f64,
         _v_t: Vec3,
         _c: &ContactInput,
+        _energy: bool,
     ) -> TangentialForce {
         TangentialForce::default()
     }

@@ -176,6 +176,10 @@ pub struct EngineConfig {
     /// scene height and the initial and injection speeds).
     #[serde(default)]
     pub impact_speed_m_s: Option<f64>,
+    /// Book elastic and dissipated energy per contact (default true; false is ~10 % faster and leaves
+    /// `elastic_J` and `dissipated_J` at zero).
+    #[serde(default = "yes")]
+    pub track_energy: bool,
 }
 
 fn default_overlap_fraction() -> f64 {
@@ -192,6 +196,7 @@ impl Default for EngineConfig {
             domain_min_m: None,
             domain_max_m: None,
             impact_speed_m_s: None,
+            track_energy: true,
         }
     }
 }

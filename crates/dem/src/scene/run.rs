@@ -56,24 +56,28 @@ pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> 
     // One monomorphised engine per combination.
     match (c.normal, c.tangential) {
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
-            run_with(Composed::new(Hertz, damping, Mindlin, r), cfg, ctx)
+            run_with(tracked(Composed::new(Hertz, damping, Mindlin, r), cfg), cfg, ctx)
         }
         (NormalKind::Hertz, TangentialKind::Linear) => {
-            run_with(Composed::new(Hertz, damping, linear, r), cfg, ctx)
+            run_with(tracked(Composed::new(Hertz, damping, linear, r), cfg), cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Mindlin) => {
-            run_with(Composed::new(hooke, damping, Mindlin, r), cfg, ctx)
+            run_with(tracked(Composed::new(hooke, damping, Mindlin, r), cfg), cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
-            run_with(Composed::new(hooke, damping, linear, r), cfg, ctx)
+            run_with(tracked(Composed::new(hooke, damping, linear, r), cfg), cfg, ctx)
         }
-        (NormalKind::Jkr, _) => run_with(Composed::new(jkr, damping, Mindlin, r), cfg, ctx),
-        (NormalKind::Dmt, _) => {
-            run_with(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg, ctx)
-        }
-        (NormalKind::Sjkr, _) => {
-            run_with(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg, ctx)
-        }
+        (NormalKind::Jkr, _) => run_with(tracked(Composed::new(jkr, damping, Mindlin, r), cfg), cfg, ctx),
+        (NormalKind::Dmt, _) => run_with(
+            tracked(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            cfg,
+            ctx,
+        ),
+        (NormalKind::Sjkr, _) => run_with(
+            tracked(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            cfg,
+            ctx,
+        ),
     }
 }
 
@@ -128,6 +132,12 @@ impl Outputs {
         self.index += 1;
         Ok(())
     }
+}
+
+/// Applies the scene's energy-tracking choice to a composed law.
+fn tracked<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> Composed<N, D, T, R> {
+    law.energy = cfg.engine.track_energy;
+    law
 }
 
 fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> {

@@ -322,6 +322,8 @@ impl<L: ContactLaw> Simulation<L> {
             let mut buf = [Candidate::default(); BUF];
             for i in g.work_begin as usize..g.work_end as usize {
                 let (mut k, k1) = (l_start[i] as usize, l_start[i + 1] as usize);
+                // Force and torque on i are summed in registers and stored once.
+                let (mut fi, mut ti) = (Vec3::ZERO, Vec3::ZERO);
                 while k < k1 {
                     let mut nbuf = 0;
                     while k < k1 && nbuf < BUF {
@@ -380,12 +382,15 @@ impl<L: ContactLaw> Simulation<L> {
                             None => *state = default,
                             Some(o) => {
                                 let (ra, rb) = (radius[a], radius[b]);
+                                // The force acts on a; i is a or b.
+                                let (j, s, ri, rj) =
+                                    if a == i { (b, 1.0, ra, rb) } else { (a, -1.0, rb, ra) };
                                 let fv = o.force;
                                 let cr = c.normal.cross(fv);
-                                f[a - pbase] += fv;
-                                f[b - pbase] -= fv;
-                                tq[a - pbase] += o.rolling_torque - ra * cr;
-                                tq[b - pbase] += -o.rolling_torque - rb * cr;
+                                fi += s * fv;
+                                ti += s * o.rolling_torque - ri * cr;
+                                f[j - pbase] -= s * fv;
+                                tq[j - pbase] += -s * o.rolling_torque - rj * cr;
                                 acc.dissipated += o.dissipated;
                                 acc.elastic += o.energy;
                                 acc.pair_contacts += 1;
@@ -397,6 +402,8 @@ impl<L: ContactLaw> Simulation<L> {
                         }
                     }
                 }
+                f[i - pbase] += fi;
+                tq[i - pbase] += ti;
             }
             acc
         };

@@ -226,3 +226,22 @@ fn blow_ups_name_the_particle_the_step_and_the_cause() {
     let err = sim.run_steps(1000).unwrap_err().to_string();
     assert!(err.contains("particle id 0") && err.contains("Rayleigh") && err.contains("step"), "{err}");
 }
+
+#[test]
+fn switching_off_energy_bookkeeping_leaves_the_motion_unchanged() {
+    let run = |energy: bool| {
+        let mats = vec![soft()];
+        let law = HertzMindlin { energy, ..Default::default() };
+        let mut sim =
+            Simulation::new(law, mats.clone(), uniform_pairs(&mats, 0.5, 0.5), 2e-5, Settings::default());
+        sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+        box_walls(&mut sim, 0.1, 0, 0, true);
+        fill(&mut sim, 0.1, 200, (0.008, 0.012), 0.5, 3);
+        sim.run_steps(300).unwrap();
+        (sim.particles.clone(), sim.energy())
+    };
+    let (a, ea) = run(true);
+    let (b, eb) = run(false);
+    assert_eq!(a, b, "forces must not depend on the bookkeeping");
+    assert!(ea.dissipated > 0.0 && eb.dissipated == 0.0 && eb.elastic == 0.0);
+}
