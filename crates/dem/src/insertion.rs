@@ -354,4 +354,33 @@ mod tests {
         let nr = Injector::number_rate(InjectionRate::KgPerSecond(1e-3), &inj.dist, 2500.0);
         assert!((nr - 1e-3 / (2500.0 * PI / 6.0 * 8e-9)).abs() < 1e-9);
     }
+
+    #[test]
+    fn random_fill_inside_a_closed_mesh() {
+        // A closed box mesh [0, 0.1]³ made of 12 triangles: every sphere lies inside, none overlaps.
+        let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z) * 0.1;
+        let quads = [
+            [v(0., 0., 0.), v(0., 1., 0.), v(1., 1., 0.), v(1., 0., 0.)],
+            [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)],
+            [v(0., 1., 0.), v(0., 1., 1.), v(1., 1., 1.), v(1., 1., 0.)],
+            [v(0., 0., 0.), v(0., 0., 1.), v(0., 1., 1.), v(0., 1., 0.)],
+            [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)],
+        ];
+        let mut soup = Vec::new();
+        for q in quads {
+            soup.extend_from_slice(&[q[0], q[1], q[2], q[0], q[2], q[3]]);
+        }
+        let region = Region::mesh(TriMesh::from_triangle_soup(&soup));
+        assert!((region.volume() - 1e-3).abs() < 1e-12);
+        let dist = SizeDistribution::Mono { diameter: 0.01 };
+        let got = random_fill(&region, &dist, FillTarget::Count(200), &[], 100_000, &mut seeded(5, 5));
+        assert_eq!(got.len(), 200);
+        for (k, (x, r)) in got.iter().enumerate() {
+            assert!(x.cmpge(Vec3::splat(*r - 1e-12)).all() && x.cmple(Vec3::splat(0.1 - r + 1e-12)).all());
+            for (y, s) in &got[k + 1..] {
+                assert!((*x - *y).length() >= r + s);
+            }
+        }
+    }
 }

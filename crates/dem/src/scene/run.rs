@@ -378,10 +378,12 @@ fn summary<L: ContactLaw>(
         e.total()
     ));
     s.headline.push(format!(
-        "contacts: {} particle-particle, {} particle-wall; time step {:.1} % of the Rayleigh time",
+        "contacts: {} particle-particle, {} particle-wall; time step {:.1} % of the Rayleigh time; {:.0} bytes \
+         of state per particle",
         e.pair_contacts,
         e.wall_contacts,
-        100.0 * cfg.dt_s / sim.rayleigh_time()
+        100.0 * cfg.dt_s / sim.rayleigh_time(),
+        sim.bytes_per_particle()
     ));
     for w in warnings {
         s.headline.push(format!("warning: {w}"));
