@@ -152,6 +152,32 @@ impl SphParams {
         gamma * mc / ma
     }
 
+    /// Pressure that the Akinci cohesion adds to the equation-of-state pressure in the bulk (its virial
+    /// pressure at uniform density): 2D `(π/2) ρ₀² γ ∫ r² C dr`, 3D `(2π/3) ρ₀² γ ∫ r³ C dr` \[Pa\].
+    /// Inside a cohesive liquid at rest the EOS pressure is this plus the Laplace jump (measured: 676 Pa
+    /// predicted, ≈ 700 Pa found for σ = 0.072 N/m, dp = 0.2 mm, 2D).
+    pub fn cohesive_pressure(&self) -> f64 {
+        let gamma = self.cohesion_coefficient();
+        if gamma == 0.0 {
+            return 0.0;
+        }
+        let support = self.kernel().support();
+        let d = self.dim.count();
+        let n = 4000;
+        let dr = support / n as f64;
+        let moment: f64 = (0..n)
+            .map(|i| {
+                let r = (i as f64 + 0.5) * dr;
+                r.powi(d) * crate::kernel::akinci_cohesion(r, support) * dr
+            })
+            .sum();
+        let rho2 = self.rest_density * self.rest_density;
+        match self.dim {
+            Dim::Two => std::f64::consts::PI / 2.0 * rho2 * gamma * moment,
+            Dim::Three => 2.0 * std::f64::consts::PI / 3.0 * rho2 * gamma * moment,
+        }
+    }
+
     /// The Akinci cohesion coefficient γ that gives surface tension σ for a flat interface in the
     /// continuum limit (Kirkwood–Buff/Fowler integral of the pair potential, uniform density):
     /// 3D `σ = (π/8) ρ₀² γ ∫ r⁴ C(r) dr`, 2D `σ = (ρ₀²/3) γ ∫ r³ C(r) dr`.

@@ -100,6 +100,10 @@ pub fn sessile_drop(d: &SessileDrop) -> Result<SessileResult, SphError> {
         }
     }
     sim.add_particles(&pts, Vec3::ZERO);
+    // Start at the density the cohesion compresses the liquid to, so that the drop is not thrown off the
+    // wall by the compression transient.
+    let rho_c = sim.params.eos().density(sim.params.cohesive_pressure());
+    sim.fluid.rho.iter_mut().for_each(|r| *r = rho_c);
     sim.set_domain(Aabb::new(Vec3::splat(-4.0 * r), Vec3::splat(4.0 * r)));
     let tc = (rho * r * r * r / sigma).sqrt();
     sim.initialize()?;
