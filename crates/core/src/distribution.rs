@@ -15,7 +15,7 @@ pub enum PsdBasis {
 /// A distribution of particle diameters \[m\]. Sampling always draws particles by number, so a mass-based
 /// table is converted (within each table interval the mass density is taken as uniform in d).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SizeDistribution {
     /// Every particle has `diameter`.
     Mono { diameter: f64 },
@@ -217,6 +217,13 @@ mod tests {
             basis: PsdBasis::Mass,
         };
         assert!((mean_of(&t, 200_000) / (4.0 / 3.0 * 1e-3) - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn misspelled_keys_are_rejected() {
+        let e = serde_json::from_str::<SizeDistribution>(r#"{"kind":"mono","diameter":1e-5,"typo":3}"#)
+            .unwrap_err();
+        assert!(e.to_string().contains("unknown field `typo`"), "{e}");
     }
 
     #[test]

@@ -22,6 +22,8 @@ pub struct CellGrid {
     cell_start: Vec<u32>,
     entries: Vec<u32>,
     point_cell: Vec<u32>,
+    /// Scratch: next free slot of each cell during the scatter (kept to reuse its allocation).
+    cursor: Vec<u32>,
 }
 
 impl CellGrid {
@@ -76,9 +78,10 @@ impl CellGrid {
         }
         self.entries.resize(n, 0);
         // Scatter with a running cursor per cell; point order within a cell stays ascending (stable).
-        let mut cursor: Vec<u32> = self.cell_start[..ncells].to_vec();
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.cell_start[..ncells]);
         for (i, &c) in self.point_cell.iter().enumerate() {
-            let slot = &mut cursor[c as usize];
+            let slot = &mut self.cursor[c as usize];
             self.entries[*slot as usize] = i as u32;
             *slot += 1;
         }

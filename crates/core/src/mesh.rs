@@ -250,7 +250,8 @@ impl TriMesh {
         for tri in points.chunks_exact(3) {
             let mut t = [0u32; 3];
             for (k, p) in tri.iter().enumerate() {
-                let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                // `+ 0.0` turns −0.0 into +0.0, so the two spellings of zero weld into one vertex.
+                let key = [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()];
                 t[k] = *map.entry(key).or_insert_with(|| {
                     vertices.push(*p);
                     (vertices.len() - 1) as u32
@@ -472,6 +473,21 @@ mod tests {
         assert!((back.total_area() - 2.0).abs() < 1e-6);
         let topo = back.topology();
         assert_eq!(topo.edge_use_count.iter().filter(|&&c| c == 2).count(), 3, "three interior edges");
+    }
+
+    #[test]
+    fn negative_zero_welds_with_zero() {
+        let soup = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(-0.0, 0.0, -0.0),
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::new(1.0, -0.0, 0.0),
+        ];
+        let m = TriMesh::from_triangle_soup(&soup);
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.topology().edge_use_count.iter().filter(|&&c| c == 2).count(), 1, "shared edge found");
     }
 
     #[test]
