@@ -24,6 +24,8 @@ pub struct BenchResult {
     pub interactions_per_s: f64,
     pub interactions_per_particle: f64,
     pub bytes_per_particle: f64,
+    /// Wall-clock milliseconds per step in the phases of the step.
+    pub phase_ms: crate::sim::PhaseTimes,
 }
 
 /// The dam break of the benchmark: column a × 2a × a (x, z, y) with `n` particles across a, in a tank
@@ -61,12 +63,23 @@ pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, cra
             sim.step()?;
         }
         let mut interactions = 0u64;
+        let p0 = sim.phase_times();
         let t0 = Instant::now();
         for _ in 0..steps {
             sim.step()?;
             interactions += sim.last.interactions;
         }
         let seconds = t0.elapsed().as_secs_f64();
+        let p1 = sim.phase_times();
+        let ms = |a: f64, b: f64| (b - a) * 1e3 / steps as f64;
+        let phase_ms = crate::sim::PhaseTimes {
+            predict: ms(p0.predict, p1.predict),
+            walls_guard: ms(p0.walls_guard, p1.walls_guard),
+            sort: ms(p0.sort, p1.sort),
+            wall_state: ms(p0.wall_state, p1.wall_state),
+            forces: ms(p0.forces, p1.forces),
+            correct: ms(p0.correct, p1.correct),
+        };
         let nf = sim.fluid.len();
         Ok(BenchResult {
             threads,
@@ -78,6 +91,7 @@ pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, cra
             interactions_per_s: interactions as f64 / seconds,
             interactions_per_particle: interactions as f64 / (steps as f64 * nf as f64),
             bytes_per_particle: sim.bytes_per_particle(),
+            phase_ms,
         })
     })
 }
