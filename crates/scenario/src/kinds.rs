@@ -6,6 +6,7 @@
 
 #[allow(unused_imports)]
 use crate::parse::{typed, validate, ScenarioError};
+use crate::paths::absolute_paths;
 use crate::source::Source;
 use serde::Serialize;
 use spatter_core::check::Validate;
@@ -48,9 +49,10 @@ macro_rules! kinds {
             fn read(kind: &str, src: &Source, body: &str) -> Result<Option<Self>, Vec<ScenarioError>> {
                 match kind {
                     $( $name => {
-                        let mut cfg: $cfg = typed(src, body).map_err(|e| vec![e])?;
+                        let cfg: $cfg = typed(src, body).map_err(|e| vec![e])?;
                         validate(src, &cfg)?;
-                        ScenarioFolder::set_base_dir(&mut cfg, &src.base_dir());
+                        let cfg = absolute_paths(cfg, &src.base_dir())
+                            .map_err(|e| vec![ScenarioError::whole_file(&src.path, e)])?;
                         Ok(Some(Scenario::$variant(cfg)))
                     } )*
                     _ => Ok(None),
@@ -71,41 +73,6 @@ kinds! {
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
-}
-
-/// Configurations that name files learn the scenario's folder, against which their relative paths are
-/// resolved at run time (validation already resolves them there).
-trait ScenarioFolder {
-    fn set_base_dir(&mut self, _dir: &Path) {}
-}
-
-impl ScenarioFolder for spatter_workflows::snow::SnowConfig {}
-
-impl ScenarioFolder for spatter_dem::SceneConfig {
-    fn set_base_dir(&mut self, dir: &Path) {
-        self.base_dir = Some(dir.to_owned());
-    }
-}
-
-impl ScenarioFolder for spatter_sph::scene::SphConfig {
-    /// Makes wall-mesh and motion-table paths absolute.
-    fn set_base_dir(&mut self, dir: &Path) {
-        let absolute = |p: &mut Option<std::path::PathBuf>| {
-            if let Some(f) = p.as_mut().filter(|f| f.is_relative()) {
-                *f = dir.join(&*f);
-            }
-        };
-        self.walls.iter_mut().for_each(|w| absolute(&mut w.file));
-        self.motions.iter_mut().for_each(|m| absolute(&mut m.file));
-    }
-}
-
-impl ScenarioFolder for spatter_workflows::deposition::ForcesConfig {}
-
-impl ScenarioFolder for spatter_workflows::deposition::DepositionConfig {
-    fn set_base_dir(&mut self, dir: &Path) {
-        self.base_dir = Some(dir.to_owned());
-    }
 }
 
 #[allow(dead_code)]

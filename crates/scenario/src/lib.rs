@@ -8,10 +8,12 @@
 //!
 //! * [`source`] — reading the file and locating byte offsets and key paths in it;
 //! * [`parse`] — typed deserialisation and validation with located errors;
+//! * [`paths`] — relative file paths made absolute against the scenario's folder;
 //! * [`kinds`] — the registry of scenario kinds.
 
 pub mod kinds;
 pub mod parse;
+pub mod paths;
 pub mod source;
 
 pub use kinds::{load, load_str, Loaded, Scenario, KINDS};
