@@ -149,8 +149,9 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
         }
     }
 
-    // Sound speed: c₀ ≥ 10 U_max, U_max from the free-fall speed over the fill height, the fill
-    // velocities and the wall speeds over the run.
+    // Sound speed: c₀ ≥ 10 U_max, U_max from the dam-break front speed 2√(gH) over the fill height H
+    // (Ritter 1892; it bounds gravity-driven flows released from rest), the fill velocities and the wall
+    // speeds over the run.
     let g = sim.params.gravity.length();
     let mut u_est: f64 = 0.0;
     for fc in &cfg.fill {
@@ -169,7 +170,7 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
         } else {
             0.0
         };
-        u_est = u_est.max((2.0 * g * height).sqrt()).max(fc.velocity_m_s.length());
+        u_est = u_est.max(2.0 * (g * height).sqrt()).max(fc.velocity_m_s.length());
     }
     for k in 0..=8 {
         let t = cfg.output.end_time_s * k as f64 / 8.0;
