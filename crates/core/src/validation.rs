@@ -25,6 +25,26 @@ pub struct Check {
 }
 
 impl Check {
+    /// A comparison judged by `tolerance`.
+    pub fn new(
+        case: impl Into<String>,
+        quantity: impl Into<String>,
+        reference: f64,
+        ours: f64,
+        tolerance: Tolerance,
+        source: impl Into<String>,
+    ) -> Self {
+        Check {
+            case: case.into(),
+            quantity: quantity.into(),
+            reference,
+            ours,
+            tolerance,
+            source: source.into(),
+        }
+    }
+
+    /// Passes when |ours − reference| ≤ tol · |reference|.
     pub fn relative(
         case: impl Into<String>,
         quantity: impl Into<String>,
@@ -33,16 +53,10 @@ impl Check {
         tol: f64,
         source: impl Into<String>,
     ) -> Self {
-        Check {
-            case: case.into(),
-            quantity: quantity.into(),
-            reference,
-            ours,
-            tolerance: Tolerance::Relative(tol),
-            source: source.into(),
-        }
+        Self::new(case, quantity, reference, ours, Tolerance::Relative(tol), source)
     }
 
+    /// Passes when |ours − reference| ≤ tol.
     pub fn absolute(
         case: impl Into<String>,
         quantity: impl Into<String>,
@@ -51,14 +65,7 @@ impl Check {
         tol: f64,
         source: impl Into<String>,
     ) -> Self {
-        Check {
-            case: case.into(),
-            quantity: quantity.into(),
-            reference,
-            ours,
-            tolerance: Tolerance::Absolute(tol),
-            source: source.into(),
-        }
+        Self::new(case, quantity, reference, ours, Tolerance::Absolute(tol), source)
     }
 
     /// Relative error |ours − reference| / |reference| (absolute error when the reference is 0).
