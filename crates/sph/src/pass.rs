@@ -117,6 +117,7 @@ pub(crate) struct WallSet<'a> {
     pub src: &'a [u32],
     /// Reference positions and part frames, for wall accelerations.
     pub ref_pos: &'a [Vec3],
+    pub ref_normal: &'a [Vec3],
     pub frames: &'a [crate::boundary::Frame],
     /// Dummy velocity for the laminar term.
     pub vvisc: &'a [Vec3],
@@ -164,6 +165,8 @@ pub(crate) struct Consts {
     pub eos: crate::eos::Tait,
     pub akinci: AkinciSplines,
     pub wet_d2: f64,
+    /// Distance from a wall particle to the surface point it stands for, per part (dp/2 for lattice walls).
+    pub wet_offset: Vec<f64>,
     pub slip_free: Vec<bool>,
 }
 
@@ -255,6 +258,14 @@ pub(crate) fn wall_state(
                 for o in 0..rho_c.len() {
                     let b = ci * CHUNK + o;
                     let xb = wl.pos[b];
+                    // Wetness is judged from the point of the wall surface the particle stands for.
+                    let part = wl.part[b] as usize;
+                    let xs = if c.wet_offset[part] > 0.0 {
+                        let f = &wl.frames[part];
+                        xb + f.rot * wl.ref_normal[wl.src[b] as usize] * c.wet_offset[part]
+                    } else {
+                        xb
+                    };
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
                     let mut is_wet = false;
                     for set in [fl, gh] {
@@ -268,7 +279,7 @@ pub(crate) fn wall_state(
                                     spw += c.eos.pressure(set.rho[j]) * w;
                                     srx += dx * (set.rho[j] * w);
                                     svw += set.vel[j] * w;
-                                    is_wet |= r2 < c.wet_d2;
+                                    is_wet |= (xs - set.pos[j]).length_squared() < c.wet_d2;
                                 }
                             }
                         });

@@ -434,6 +434,18 @@ impl Simulation {
             eos,
             akinci: crate::kernel::AkinciSplines::new(support),
             wet_d2: p.wet_distance * p.wet_distance,
+            wet_offset: self
+                .boundary
+                .parts
+                .iter()
+                .map(|q| {
+                    if matches!(q.sampling, crate::boundary::Sampling::Lattice) {
+                        0.5 * p.spacing
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }
     }
@@ -625,6 +637,7 @@ impl Simulation {
             vel: &w.w_vel,
             src: &w.w_src,
             ref_pos: &self.boundary.ref_pos,
+            ref_normal: &self.boundary.ref_normal,
             frames: &self.boundary.frames,
             vvisc: &[],
             rho: &[],
@@ -725,6 +738,7 @@ impl Simulation {
             vel: &w.w_vel,
             src: &w.w_src,
             ref_pos: &self.boundary.ref_pos,
+            ref_normal: &self.boundary.ref_normal,
             frames: &self.boundary.frames,
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
@@ -1048,6 +1062,7 @@ impl Simulation {
             vel: &w.w_vel,
             src: &w.w_src,
             ref_pos: &self.boundary.ref_pos,
+            ref_normal: &self.boundary.ref_normal,
             frames: &self.boundary.frames,
             vvisc: &w.w_vvisc,
             rho: &w.w_rho,
