@@ -5,7 +5,7 @@
 //! four sides), settled under gravity for a few hundred steps (untimed), then advanced for a fixed number
 //! of steps with 1 and with 2 threads from the same state. Printed: particle-steps per second for both
 //! thread counts, the parallel efficiency, the state bytes per particle (particles, neighbour list with
-//! contact histories, wall candidates, cell grid), and the Verlet-list versus every-step cell search
+//! contact histories, wall candidates; the cell grid lives only during rebuilds), and the Verlet-list versus every-step cell search
 //! comparison.
 //!
 //! [`write_lammps_data`] writes the settled state as a LAMMPS data file for `bench/dem/compare.sh`, which
@@ -286,7 +286,7 @@ pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
         wl.rate() / nl.rate()
     ));
     lines.push(format!(
-        "  memory: {:.0} bytes per particle (particles, pair list with histories, wall candidates, grid)",
+        "  memory: {:.0} bytes per particle between steps (particles, pair list with histories, wall candidates)",
         sim.bytes_per_particle()
     ));
     Ok(lines)

@@ -4,7 +4,7 @@
 //! particle's *index* therefore changes over a run, its *id* never does. Contact history is keyed by ids.
 //!
 //! Frozen particles (rough walls made of fixed spheres) have infinite mass and moment of inertia
-//! (`inv_mass = inv_inertia = 0`): they are never integrated, keep the velocity they were given, and a
+//! (`inv_mass = 0`): they are never integrated, keep the velocity they were given, and a
 //! contact with one behaves like a contact with a rigid body (m* = m of the free partner).
 
 use serde::{Deserialize, Serialize};
@@ -26,12 +26,8 @@ pub struct Particles {
     pub omega: Vec<Vec3>,
     /// Radius \[m\].
     pub radius: Vec<f64>,
-    /// Mass \[kg\] (of the sphere's material, also for frozen particles).
-    pub mass: Vec<f64>,
     /// 1/m \[1/kg\]; 0 for a frozen particle.
     pub inv_mass: Vec<f64>,
-    /// 1/I \[1/(kg m²)\] with I = (2/5) m r²; 0 for a frozen particle.
-    pub inv_inertia: Vec<f64>,
     /// Force of the last evaluation \[N\] (contacts, gravity, external).
     pub force: Vec<Vec3>,
     /// Torque of the last evaluation \[N m\].
@@ -88,16 +84,13 @@ impl Particles {
         let id = self.next_id;
         self.next_id += 1;
         let m = density * sphere_volume(p.radius);
-        let inertia = 0.4 * m * p.radius * p.radius;
         self.id.push(id);
         self.material.push(p.material);
         self.pos.push(p.pos);
         self.vel.push(p.vel);
         self.omega.push(if p.frozen { Vec3::ZERO } else { p.omega });
         self.radius.push(p.radius);
-        self.mass.push(m);
         self.inv_mass.push(if p.frozen { 0.0 } else { 1.0 / m });
-        self.inv_inertia.push(if p.frozen { 0.0 } else { 1.0 / inertia });
         self.force.push(Vec3::ZERO);
         self.torque.push(Vec3::ZERO);
         if !self.ext_force.is_empty() {
@@ -113,9 +106,26 @@ impl Particles {
         self.inv_mass[i] == 0.0
     }
 
-    /// Moment of inertia of particle `i` \[kg m²\] (of its material, also when frozen).
+    /// Mass of particle `i` \[kg\] (∞ for a frozen particle).
+    #[inline]
+    pub fn mass(&self, i: usize) -> f64 {
+        1.0 / self.inv_mass[i]
+    }
+
+    /// 1/I of particle `i` \[1/(kg m²)\], I = (2/5) m r² (0 for a frozen particle).
+    #[inline]
+    pub fn inv_inertia(&self, i: usize) -> f64 {
+        2.5 * self.inv_mass[i] / (self.radius[i] * self.radius[i])
+    }
+
+    /// Moment of inertia of particle `i` \[kg m²\] (∞ for a frozen particle).
     pub fn inertia(&self, i: usize) -> f64 {
-        0.4 * self.mass[i] * self.radius[i] * self.radius[i]
+        0.4 * self.radius[i] * self.radius[i] / self.inv_mass[i]
+    }
+
+    /// Total mass of the free (not frozen) particles \[kg\].
+    pub fn free_mass(&self) -> f64 {
+        self.inv_mass.iter().filter(|&&m| m > 0.0).map(|m| 1.0 / m).sum()
     }
 
     /// The persistent external force and torque arrays (allocated on first call). Values stay until
@@ -155,9 +165,7 @@ impl Particles {
         apply(&mut self.ext_force, perm, &mut s.vecs);
         apply(&mut self.ext_torque, perm, &mut s.vecs);
         apply(&mut self.radius, perm, &mut s.f64s);
-        apply(&mut self.mass, perm, &mut s.f64s);
         apply(&mut self.inv_mass, perm, &mut s.f64s);
-        apply(&mut self.inv_inertia, perm, &mut s.f64s);
     }
 
     /// Removes the particles for which `remove(index)` is true (order of the rest is kept).
@@ -184,15 +192,13 @@ impl Particles {
         filter(&mut self.ext_force, &mask);
         filter(&mut self.ext_torque, &mask);
         filter(&mut self.radius, &mask);
-        filter(&mut self.mass, &mask);
         filter(&mut self.inv_mass, &mask);
-        filter(&mut self.inv_inertia, &mask);
     }
 
     /// Bytes of particle state per particle (for memory reports).
     pub fn bytes_per_particle(&self) -> usize {
         let ext = if self.ext_force.is_empty() { 0 } else { 48 };
-        4 + 2 + 5 * 24 + 4 * 8 + ext
+        4 + 2 + 5 * 24 + 2 * 8 + ext
     }
 }
 
@@ -225,7 +231,7 @@ mod tests {
             assert_eq!(p.radius[i], 0.1 + 0.01 * p.id[i] as f64);
         }
         let f = p.index_of(3).unwrap();
-        assert!(p.is_frozen(f) && p.inv_inertia[f] == 0.0 && p.mass[f] > 0.0);
+        assert!(p.is_frozen(f) && p.inv_inertia(f) == 0.0 && p.mass(f).is_infinite());
         p.retain(|i| p_id_not(i, 2));
         fn p_id_not(i: usize, idx: usize) -> bool {
             i != idx

@@ -82,6 +82,18 @@ impl<P: Clone> PairTable<P> {
         &self.items[a * self.n + b]
     }
 
+    /// Value at flat index `k = a·n + b`.
+    #[inline(always)]
+    pub fn at(&self, k: usize) -> &P {
+        &self.items[k]
+    }
+
+    /// Flat index `a·n + b` for [`PairTable::at`].
+    #[inline(always)]
+    pub fn flat(&self, a: usize, b: usize) -> usize {
+        a * self.n + b
+    }
+
     /// The pair index of (a, b) (same for (b, a)): `min·n + max`.
     #[inline(always)]
     pub fn index(&self, a: usize, b: usize) -> usize {

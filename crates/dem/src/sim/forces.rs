@@ -78,12 +78,12 @@ impl<L: ContactLaw> Simulation<L> {
             let has_ext = !p.ext_force.is_empty();
             let (ext_f, ext_t) = (&p.ext_force, &p.ext_torque);
             const CHUNK: usize = 4096;
-            let (mass, inv_mass) = (&p.mass, &p.inv_mass);
+            let inv_mass = &p.inv_mass;
             p.force.par_chunks_mut(CHUNK).zip(p.torque.par_chunks_mut(CHUNK)).enumerate().for_each(
                 |(c, (fs, ts))| {
                     for (k, (f, tq)) in fs.iter_mut().zip(ts.iter_mut()).enumerate() {
                         let i = c * CHUNK + k;
-                        *f = if inv_mass[i] > 0.0 { mass[i] * g } else { Vec3::ZERO };
+                        *f = if inv_mass[i] > 0.0 { g / inv_mass[i] } else { Vec3::ZERO };
                         *tq = Vec3::ZERO;
                         if has_ext {
                             *f += ext_f[i];
@@ -116,7 +116,7 @@ impl<L: ContactLaw> Simulation<L> {
                 vel: &p.vel,
                 omega: &p.omega,
                 radius: &p.radius,
-                mass: &p.mass,
+                inv_mass: &p.inv_mass,
             };
             ext.add(t, &view, bf, bt);
             for i in 0..n {
@@ -139,15 +139,13 @@ impl<L: ContactLaw> Simulation<L> {
             vel,
             omega,
             radius,
-            mass,
             inv_mass,
-            inv_inertia,
             force,
             torque,
             ..
         } = &mut self.particles;
-        let (id, material, pos, vel, omega, radius, mass, inv_mass, inv_inertia) =
-            (&*id, &*material, &*pos, &*vel, &*omega, &*radius, &*mass, &*inv_mass, &*inv_inertia);
+        let (id, material, pos, vel, omega, radius, inv_mass) =
+            (&*id, &*material, &*pos, &*vel, &*omega, &*radius, &*inv_mass);
         let default = L::State::default();
 
         // Wall contacts: each particle owns its slots.
@@ -184,8 +182,8 @@ impl<L: ContactLaw> Simulation<L> {
                                 normal: n,
                                 overlap: r - hit.distance,
                                 r_eff: r,
-                                m_eff: mass[i],
-                                i_eff: 0.4 * mass[i] * r * r,
+                                m_eff: 1.0 / inv_mass[i],
+                                i_eff: 0.4 * r * r / inv_mass[i],
                                 v_rel: vel[i] - r * omega[i].cross(n) - v_wall,
                                 w_rel: omega[i] - kw.omega,
                                 dt,
@@ -311,6 +309,7 @@ impl<L: ContactLaw> Simulation<L> {
             k: usize,
             a: usize,
             b: usize,
+            pair: usize,
             c: ContactInput,
         }
         let pair_work = |g: &Group,
@@ -327,10 +326,11 @@ impl<L: ContactLaw> Simulation<L> {
                 while k < k1 {
                     let mut nbuf = 0;
                     while k < k1 && nbuf < BUF {
-                        let j = l_nbr[k] as usize;
-                        // Orientation by id keeps each state in the lower-id particle's frame
-                        // (branch-free: the order of ids within a sorted list is random).
-                        let swap = (id[j] < id[i]) as usize;
+                        let e = l_nbr[k];
+                        let j = (e & super::neighbors::NBR_MASK) as usize;
+                        // Orientation by id (flagged in the list's top bit) keeps each state in the
+                        // lower-id particle's frame; branch-free, the id order is random.
+                        let swap = (e >> 31) as usize;
                         let a = i ^ ((i ^ j) & swap.wrapping_neg());
                         let b = i ^ j ^ a;
                         let d = pos[a] - pos[b];
@@ -352,7 +352,8 @@ impl<L: ContactLaw> Simulation<L> {
                         let inv = inv_mass[a] + inv_mass[b];
                         let q = 1.0 / (rs * inv);
                         let (i_eff, w_rel) = if L::USES_ROTATION {
-                            (1.0 / (inv_inertia[a] + inv_inertia[b]), omega[a] - omega[b])
+                            let inv_i = 2.5 * (inv_mass[a] / (ra * ra) + inv_mass[b] / (rb * rb));
+                            (1.0 / inv_i, omega[a] - omega[b])
                         } else {
                             (0.0, Vec3::ZERO)
                         };
@@ -360,6 +361,7 @@ impl<L: ContactLaw> Simulation<L> {
                             k,
                             a,
                             b,
+                            pair: params.flat(material[a] as usize, material[b] as usize),
                             c: ContactInput {
                                 normal: n,
                                 overlap: rs - dist,
@@ -377,7 +379,7 @@ impl<L: ContactLaw> Simulation<L> {
                     for cand in &buf[..nbuf] {
                         let (a, b, c) = (cand.a, cand.b, &cand.c);
                         let state = &mut states[cand.k - sbase];
-                        let pp = params.get(material[a] as usize, material[b] as usize);
+                        let pp = params.at(cand.pair);
                         match law.compute(pp, c, state) {
                             None => *state = default,
                             Some(o) => {

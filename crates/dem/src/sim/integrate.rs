@@ -30,7 +30,7 @@ impl<L: ContactLaw> Simulation<L> {
         let dt = self.dt;
         let g = self.gravity;
         let p = &mut self.particles;
-        let (inv_m, inv_i, mass) = (&p.inv_mass, &p.inv_inertia, &p.mass);
+        let (inv_m, radius) = (&p.inv_mass, &p.radius);
         let (ext_f, ext_t) = (&p.ext_force, &p.ext_torque);
         let has_ext = !ext_f.is_empty();
         const CHUNK: usize = 4096;
@@ -49,8 +49,10 @@ impl<L: ContactLaw> Simulation<L> {
                 for (k, ((v, w), x)) in vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut()).enumerate() {
                     let i = base + k;
                     // Frozen particles have zero inverse mass and inertia: the kick vanishes.
-                    *v += (h * inv_m[i]) * fs[k];
-                    *w += (h * inv_i[i]) * ts[k];
+                    let hm = h * inv_m[i];
+                    *v += hm * fs[k];
+                    // 1/I = 2.5/(m r²).
+                    *w += (2.5 * hm / (radius[i] * radius[i])) * ts[k];
                     if drift {
                         *x += *v * dt;
                     }
@@ -58,7 +60,7 @@ impl<L: ContactLaw> Simulation<L> {
                     m = m.max(v2);
                     check += v2 + w.length_squared() + x.length_squared();
                     if reset {
-                        fs[k] = if inv_m[i] > 0.0 { mass[i] * g } else { Vec3::ZERO };
+                        fs[k] = if inv_m[i] > 0.0 { g / inv_m[i] } else { Vec3::ZERO };
                         ts[k] = Vec3::ZERO;
                         if has_ext {
                             fs[k] += ext_f[i];

@@ -178,7 +178,8 @@ pub struct ParticleView<'a> {
     pub vel: &'a [Vec3],
     pub omega: &'a [Vec3],
     pub radius: &'a [f64],
-    pub mass: &'a [f64],
+    /// 1/m (0 for frozen particles) \[1/kg\].
+    pub inv_mass: &'a [f64],
 }
 
 /// Forces computed outside the engine (fluid drag, fields), called once per force evaluation. Add into
@@ -313,7 +314,7 @@ impl<L: ContactLaw> Simulation<L> {
         let id = self.particles.push(p, rho);
         let i = self.particles.len() - 1;
         if !p.frozen {
-            self.particles.force[i] = self.particles.mass[i] * self.gravity;
+            self.particles.force[i] = self.particles.mass(i) * self.gravity;
         }
         id
     }
@@ -499,9 +500,10 @@ impl<L: ContactLaw> Simulation<L> {
             if p.inv_mass[i] == 0.0 {
                 continue;
             }
-            ke += 0.5 * p.mass[i] * p.vel[i].length_squared();
+            let m = p.mass(i);
+            ke += 0.5 * m * p.vel[i].length_squared();
             rot += 0.5 * p.inertia(i) * p.omega[i].length_squared();
-            pot -= p.mass[i] * self.gravity.dot(p.pos[i]);
+            pot -= m * self.gravity.dot(p.pos[i]);
         }
         EnergyReport {
             time: self.st.time,
@@ -535,8 +537,8 @@ impl<L: ContactLaw> Simulation<L> {
         t
     }
 
-    /// Bytes of simulation state per particle: particle arrays, pair list with contact states, wall
-    /// candidates, neighbour-search grid.
+    /// Bytes of simulation state per particle between steps: particle arrays, pair list with contact
+    /// states, wall candidates (the cell grid and sorting buffers exist only during a rebuild).
     pub fn bytes_per_particle(&self) -> f64 {
         let n = self.particles.len().max(1) as f64;
         let s = std::mem::size_of::<L::State>();
@@ -548,8 +550,7 @@ impl<L: ContactLaw> Simulation<L> {
             + wl.tri.capacity() * 4
             + wl.state.capacity() * s
             + wl.out.capacity() * std::mem::size_of::<forces::SlotOut>();
-        let grid = 3 * 4 * self.particles.len();
-        self.particles.bytes_per_particle() as f64 + (pairs + walls + grid) as f64 / n
+        self.particles.bytes_per_particle() as f64 + (pairs + walls) as f64 / n
     }
 
     /// Number of pairs in the neighbour list.

@@ -9,8 +9,9 @@ use crate::walls::{WallKinematics, WallShape};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Half neighbour list in CSR form: the partners j > i of particle i are `nbr[start[i]..start[i+1]]`,
-/// with one contact state each (from the lower-id particle's point of view).
+/// Half neighbour list in CSR form: the partners j > i of particle i are `nbr[start[i]..start[i+1]]`
+/// (low 31 bits; the top bit is set when j has the lower id), with one contact state each (from the
+/// lower-id particle's point of view).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PairList<S> {
     pub start: Vec<u32>,
@@ -56,6 +57,9 @@ impl<S> Default for WallList<S> {
 
 const BLOCK: usize = 1024;
 
+/// Index bits of a neighbour-list entry; the top bit flags that the partner has the lower id.
+pub(crate) const NBR_MASK: u32 = 0x7fff_ffff;
+
 impl<L: ContactLaw> Simulation<L> {
     /// Rebuilds the neighbour and wall lists: removes particles outside the domain, sorts the particle
     /// arrays by cell, builds the half list and the wall candidates, and restores every contact state.
@@ -70,7 +74,7 @@ impl<L: ContactLaw> Simulation<L> {
                 for i in 0..p.len() {
                     for k in l.start[i] as usize..l.start[i + 1] as usize {
                         if l.state[k] != default {
-                            let (a, b) = (p.id[i], p.id[l.nbr[k] as usize]);
+                            let (a, b) = (p.id[i], p.id[(l.nbr[k] & NBR_MASK) as usize]);
                             carry.push((pair_key(a, b), l.state[k]));
                         }
                     }
@@ -136,7 +140,7 @@ impl<L: ContactLaw> Simulation<L> {
                         for j in run.start.max(i + 1)..run.end {
                             let c = ri + p.radius[j] + extra;
                             if (p.pos[j] - xi).length_squared() < c * c && !both_frozen(i, j) {
-                                nb.push(j as u32);
+                                nb.push(j as u32 | ((p.id[j] < p.id[i]) as u32) << 31);
                             }
                         }
                     });
@@ -164,7 +168,7 @@ impl<L: ContactLaw> Simulation<L> {
                 let i = list.start.len() - 1;
                 let s = &nb[k..k + c as usize];
                 if let Some(&last) = s.last() {
-                    span = span.max(last as usize - i + 1);
+                    span = span.max((last & NBR_MASK) as usize - i + 1);
                 }
                 list.nbr.extend_from_slice(s);
                 k += c as usize;
@@ -182,7 +186,7 @@ impl<L: ContactLaw> Simulation<L> {
             let reach = range_pp;
             for i in 0..n {
                 for k in list.start[i] as usize..list.start[i + 1] as usize {
-                    let j = list.nbr[k] as usize;
+                    let j = (list.nbr[k] & NBR_MASK) as usize;
                     let c = p.radius[i] + p.radius[j] + reach;
                     if (p.pos[j] - p.pos[i]).length_squared() >= c * c * (1.0 + 1e-9) + 1e-300 {
                         continue;
@@ -264,6 +268,11 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         blocks(n, BLOCK, &mut wl.blocks);
+
+        // Rebuild-only buffers are released: steady-state memory is the particles and the lists.
+        self.scratch.grid = spatter_core::grid::CellGrid::new();
+        self.scratch.perm = Vec::new();
+        self.scratch.permute = crate::particles::PermuteScratch::default();
 
         self.st.disp_particles = 0.0;
         self.st.disp_walls = 0.0;

@@ -171,7 +171,7 @@ fn settled_pile_rests_and_the_floor_carries_its_weight() {
     box_walls(&mut sim, 0.1, 1, 0, false);
     fill(&mut sim, 0.1, 250, (0.008, 0.012), 0.2, 21);
     let pe0 = sim.energy().potential;
-    let weight: f64 = sim.particles.mass.iter().sum::<f64>() * 9.81;
+    let weight: f64 = sim.particles.free_mass() * 9.81;
     sim.run_steps(15_000).unwrap();
     let e = sim.energy();
     let floor = sim.walls.len() - 1;
@@ -275,7 +275,7 @@ fn external_force_hook_and_persistent_forces_act_and_are_booked() {
     sim.run_steps(1000).unwrap();
     let i0 = sim.particles.index_of(0).unwrap();
     let i1 = sim.particles.index_of(1).unwrap();
-    let m = sim.particles.mass[i0];
+    let m = sim.particles.mass(i0);
     let t = sim.time();
     assert!((sim.particles.vel[i0].y / (0.02 * t / m) - 1.0).abs() < 1e-9);
     assert!((sim.particles.vel[i1].z / (-0.01 * t / m) - 1.0).abs() < 1e-9);

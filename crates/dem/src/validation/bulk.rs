@@ -101,7 +101,7 @@ pub fn settled_pile(quick: bool) -> Vec<Check> {
     box_planes(&mut sim, 0.1, 1, 0);
     fill(&mut sim, 0.1, if quick { 250 } else { 600 }, 0.2, 21);
     let pe0 = sim.energy().potential;
-    let weight: f64 = sim.particles.mass.iter().sum::<f64>() * 9.81;
+    let weight: f64 = sim.particles.free_mass() * 9.81;
     let ok = sim.run_steps(if quick { 15_000 } else { 40_000 }).is_ok();
     let e = sim.energy();
     let floor = sim.wall_force(5);
