@@ -285,3 +285,55 @@ fn driver_matches_the_dem_engine() {
         }
     }
 }
+
+#[test]
+fn sensitivity_checks_fail_on_doctored_counts() {
+    // Every check of `snow_sensitivity_stick_counts` must be able to fail. Reference: the thesis counts of
+    // Table 3 (L503–531) and our full-grid counts at 16 m/s (docs/snow.md §4.3), which pass.
+    use super::config::SensitivityCase;
+    use super::validation::sensitivity_checks;
+    let cases = SensitivityCase::thesis_table();
+    let thesis: Vec<usize> = cases.iter().map(|k| k.thesis_sticks.unwrap() as usize).collect();
+    let failed = |counts: &[usize]| -> Vec<String> {
+        sensitivity_checks(&cases, counts).into_iter().filter(|c| !c.passed()).map(|c| c.quantity).collect()
+    };
+    let ours = [249, 247, 249, 249, 249, 102, 1270, 469, 165];
+    assert!(failed(&ours).is_empty(), "{:?}", failed(&ours));
+    assert!(failed(&thesis).is_empty(), "{:?}", failed(&thesis));
+    // A model that never sticks fails every count (ln 0) and both trends; the E/ν ratios are 0/0 (NaN).
+    let never = failed(&[0; 9]);
+    assert_eq!(never.len(), 9 + 2 + 4, "{never:?}");
+    // A true factor of 2: the thesis counts ×1.95 pass, ×2.05 and ÷2.05 fail every count check.
+    let scaled = |f: f64| -> Vec<usize> { thesis.iter().map(|&t| (t as f64 * f).round() as usize).collect() };
+    assert!(failed(&scaled(1.95)).is_empty(), "{:?}", failed(&scaled(1.95)));
+    for f in [2.05, 1.0 / 2.05] {
+        let fails = failed(&scaled(f));
+        assert_eq!(fails.len(), 9, "×{f}: {fails:?}");
+        assert!(fails.iter().all(|q| q.starts_with("|ln(sticks/thesis)|")), "{fails:?}");
+    }
+    // Trends are strict: equal counts (Γ or σ_y without effect) fail, one trend check each (the count of
+    // the changed case may fail its factor-2 check as well).
+    let trend_fails = |counts: &[usize]| -> Vec<String> {
+        failed(counts).into_iter().filter(|q| !q.starts_with("|ln(sticks/thesis)|")).collect()
+    };
+    for (i, word) in [(6, "Γ=1"), (5, "Γ=1"), (7, "σ_y=0.5"), (8, "σ_y=0.5")] {
+        let mut k = ours;
+        k[i] = k[0];
+        let fails = trend_fails(&k);
+        assert_eq!(fails.len(), 1, "case {i}: {fails:?}");
+        assert!(fails[0].contains(word) && fails[0].contains("[1 = holds]"), "{fails:?}");
+    }
+    // Reversed trends fail too.
+    let mut k = ours;
+    k.swap(5, 6);
+    assert_eq!(trend_fails(&k).len(), 1);
+    let mut k = ours;
+    k.swap(7, 8);
+    assert_eq!(trend_fails(&k).len(), 1);
+    // E and ν: 6 % and 3 % changes fail (limits 5 % and 2 %), 4 % and 1.6 % pass.
+    for (i, n, fails) in [(1, 264, 1), (2, 234, 1), (1, 259, 0), (3, 257, 1), (4, 241, 1), (4, 253, 0)] {
+        let mut k = ours;
+        k[i] = n;
+        assert_eq!(failed(&k).len(), fails, "case {i} with {n} sticks: {:?}", failed(&k));
+    }
+}
