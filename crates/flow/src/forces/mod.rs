@@ -5,13 +5,13 @@
 //! (`digests/seed_003_brownout.md` §2.1). The relative velocity is written `w = u_f − v_p` (fluid minus
 //! particle) throughout, so that drag is `+w/τ`.
 //!
-//! * [`drag`] — Stokes, Schiller–Naumann, Di Felice (with and without the voidage factor),
-//!   Haider–Levenspiel and Ganser drag laws, terminal velocity;
+//! * [`drag`] — Stokes, Schiller–Naumann, Di Felice (with and without the voidage factor) and
+//!   Haider–Levenspiel (non-spherical) drag laws, terminal velocity;
 //! * [`lift`] — Saffman shear lift with Mei's correction, Magnus lift (Oesterle & Bui-Dinh) and the
 //!   rotational (Magnus) torque (Rubinow–Keller / Dennis);
 //! * [`wall_lift`] — wall-bounded lift F⁺ = p (a⁺)^q (Table 3.1 regimes) with Zeng's wall-distance factor;
-//! * [`history`] — the Basset history force with a finite window and the singular kernel integrated
-//!   analytically, Odar–Hamilton and Reeks–McKee corrections;
+//! * [`history`] — the Basset history force: a window integrated exactly (singular kernel included)
+//!   and an exponential tail for older history, Odar–Hamilton and Reeks–McKee corrections;
 //! * [`inertial`] — added mass, pressure gradient (fluid acceleration), gravity and buoyancy;
 //! * [`model`] — a switchable set of all of them as used by the tracker;
 //! * [`ranking`] — nondimensional reference magnitudes (Jasion Table 6.4) and the asperity constants.

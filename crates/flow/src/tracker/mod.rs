@@ -247,7 +247,8 @@ impl<F: FlowField> Tracker<F> {
                 .sample(p.pos, self.state.time, &mut parcel.hint, false)
                 .map(|s| s.u - p.vel)
                 .unwrap_or(Vec3::ZERO);
-            let mut h = History::new(bs.window, w0);
+            let tau_p = crate::forces::stokes_time(&self.model.fluid, p.diameter, p.density);
+            let mut h = History::new(bs.window_steps(tau_p, self.settings.dt), bs.tail, w0);
             h.u_last = w0 + p.vel;
             self.state.histories.push(h);
         }
