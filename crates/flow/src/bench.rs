@@ -8,7 +8,7 @@
 //! point location alone (the same positions and hints the next step starts from).
 
 use crate::field::tetmesh::{kuhn_box, TetMesh};
-use crate::field::{FieldError, FlowField, ImportOptions, ImportedField, Sample};
+use crate::field::{FieldError, ImportOptions, ImportedField};
 use crate::forces::model::{ForceModel, ForceSwitches};
 use crate::forces::Fluid;
 use crate::tracker::inject::NewParcel;
@@ -16,24 +16,8 @@ use crate::tracker::{Parcel, TrackSettings, Tracker, CHUNK};
 use crate::vtk::{cell_type, DataArray, VtkDataset};
 use rayon::prelude::*;
 use spatter_core::rng::{seeded, RngExt};
-use spatter_core::{Aabb, Vec3};
+use spatter_core::Vec3;
 use std::time::Instant;
-
-impl<T: FlowField> FlowField for &T {
-    #[inline]
-    fn sample(&self, x: Vec3, t: f64, hint: &mut u32, want_grad: bool) -> Option<Sample> {
-        (**self).sample(x, t, hint, want_grad)
-    }
-    fn bounds(&self) -> Option<Aabb> {
-        (**self).bounds()
-    }
-    fn has_turbulence(&self) -> bool {
-        (**self).has_turbulence()
-    }
-    fn tet_hint_count(&self) -> usize {
-        (**self).tet_hint_count()
-    }
-}
 
 fn cellular(p: Vec3) -> Vec3 {
     use std::f64::consts::PI;

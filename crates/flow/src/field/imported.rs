@@ -326,6 +326,8 @@ impl ImportedField {
         let tl = self.frames[n - 1].time;
         let t = match self.period {
             Some(p) => t0 + (t - t0).rem_euclid(p),
+            // Held before the first frame: the field does not change there (zero ∂u/∂t).
+            None if t < t0 => return (0, 0, 0.0, 0.0),
             None => t.clamp(t0, tl),
         };
         if t >= tl {
@@ -711,8 +713,10 @@ mod tests {
         let mut h = NONE;
         let s = f.sample(x, 0.25, &mut h, false).unwrap();
         assert!((s.u.x - 1.5).abs() < 1e-12 && (s.du_dt.x - 2.0).abs() < 1e-12);
-        assert_eq!(f.sample(x, 5.0, &mut h, false).unwrap().u.x, 3.0, "held after the last frame");
-        assert_eq!(f.sample(x, -1.0, &mut h, false).unwrap().u.x, 1.0, "held before the first");
+        let after = f.sample(x, 5.0, &mut h, false).unwrap();
+        assert_eq!((after.u.x, after.du_dt.x), (3.0, 0.0), "held after the last frame");
+        let before = f.sample(x, -1.0, &mut h, false).unwrap();
+        assert_eq!((before.u.x, before.du_dt.x), (1.0, 0.0), "held before the first, without a slope");
         // Cyclic with period 2: t = 1.5 lies halfway from the last frame back to the first (at t = 2).
         let opts = ImportOptions { period: Some(2.0), ..Default::default() };
         let f = ImportedField::load(&files, &opts).unwrap();

@@ -66,6 +66,23 @@ pub trait FlowField: Send + Sync {
     }
 }
 
+/// A borrowed field is a field (e.g. a tracker over a field shared with other code).
+impl<T: FlowField> FlowField for &T {
+    #[inline]
+    fn sample(&self, x: Vec3, t: f64, hint: &mut u32, want_grad: bool) -> Option<Sample> {
+        (**self).sample(x, t, hint, want_grad)
+    }
+    fn bounds(&self) -> Option<Aabb> {
+        (**self).bounds()
+    }
+    fn has_turbulence(&self) -> bool {
+        (**self).has_turbulence()
+    }
+    fn tet_hint_count(&self) -> usize {
+        (**self).tet_hint_count()
+    }
+}
+
 /// Why a flow field could not be built.
 #[derive(Debug, Error)]
 pub enum FieldError {

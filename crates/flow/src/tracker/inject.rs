@@ -113,6 +113,9 @@ impl Validate for InjectorSpec {
         c.finite_vec("velocity_m_s", self.velocity);
         c.finite("normal_speed_m_s", self.normal_speed);
         c.non_negative("velocity_spread_m_s", self.velocity_spread);
+        if self.parcels == 0 {
+            c.fail("parcels", "parcels = 0 must be at least 1 (an injector releases at least one parcel)");
+        }
         c.non_negative("start_s", self.start_s);
         if self.end_s.is_nan() || self.end_s < self.start_s {
             c.fail("end_s", format!("end_s = {} must be ≥ start_s = {}", self.end_s, self.start_s));
@@ -350,6 +353,17 @@ mod tests {
         let m: f64 = got.iter().map(|p| p.count * crate::forces::sphere_mass(p.diameter, p.density)).sum();
         assert!((m - 1e-4).abs() < 1e-15);
         assert!(got.iter().all(|p| p.pos.cmpge(Vec3::ZERO).all() && p.pos.cmple(Vec3::ONE).all()));
+    }
+
+    #[test]
+    fn zero_parcels_are_refused() {
+        // With mass_flow_kg_s the parcel mass would be mass flow × duration / 0 = ∞.
+        let mut s = spec(Region::Box { min_m: Vec3::ZERO, max_m: Vec3::ONE });
+        assert!(Checker::run(&s, None).is_ok());
+        s.parcels = 0;
+        let e = Checker::run(&s, None).unwrap_err();
+        assert_eq!(e[0].key, "parcels");
+        assert!(e[0].message.starts_with("parcels = 0 must be at least 1"), "{}", e[0].message);
     }
 
     #[test]

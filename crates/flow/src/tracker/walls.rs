@@ -134,12 +134,9 @@ impl WallRule {
                     .map_err(|source| WallRuleError::Io { path: path.clone(), source })?;
                 let map: RegimeMap = serde_json::from_str(&text)
                     .map_err(|e| WallRuleError::Format { path: path.clone(), message: e.to_string() })?;
-                if map.schema != RegimeMap::SCHEMA {
-                    return Err(WallRuleError::Format {
-                        path,
-                        message: format!("schema = \"{}\"; expected \"{}\"", map.schema, RegimeMap::SCHEMA),
-                    });
-                }
+                // Schema tag and both fits (a reversed x_range or an empty coefficient list would make
+                // every impact panic or stick wrongly); the message names the key.
+                map.check().map_err(|message| WallRuleError::Format { path, message })?;
                 WallRule::RegimeMap {
                     map,
                     bounce: *bounce,
@@ -292,5 +289,17 @@ mod tests {
         std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
         let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
         assert!(e.contains("map.json") && e.contains("spatter.regime_map.v1"), "{e}");
+        // A reversed diameter range (used to panic in the clamp of every impact) and an empty
+        // coefficient list (used to give v_crit = 10⁰ = 1 m/s silently) are refused with file and key.
+        let mut bad = test_map(1.0);
+        bad.v_crit_of_d.x_range = [1e-3, 1e-6];
+        std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
+        let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
+        assert!(e.contains("map.json") && e.contains("v_crit_of_d.x_range"), "{e}");
+        let mut bad = test_map(1.0);
+        bad.v_crit_of_d.coefficients.clear();
+        std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
+        let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
+        assert!(e.contains("map.json") && e.contains("v_crit_of_d.coefficients"), "{e}");
     }
 }

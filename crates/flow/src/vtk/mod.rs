@@ -161,6 +161,12 @@ impl VtkDataset {
         if !self.poly_faces.is_empty() && self.poly_faces.len() != nc {
             return Err(VtkError::format(path, "polyhedron face lists do not match the cell count"));
         }
+        for c in 0..nc {
+            if self.cell_types[c] == cell_type::POLYHEDRON {
+                let stream = self.poly_faces.get(c).map(Vec::as_slice).unwrap_or(&[]);
+                check_face_stream(stream, n).map_err(|m| VtkError::format(path, format!("cell {c}: {m}")))?;
+            }
+        }
         Ok(())
     }
 
@@ -189,6 +195,44 @@ impl VtkDataset {
         }
         (vec![cell_type::HEXAHEDRON; n], (0..=n).map(|c| 8 * c).collect(), conn)
     }
+}
+
+/// Checks a polyhedron's face stream `[n_faces, n_0, ids…, n_1, ids…]`: at least one face, every face
+/// with at least three points, the lengths adding up to the stream's length exactly, and every point id
+/// below `n_points`.
+fn check_face_stream(s: &[u32], n_points: usize) -> Result<(), String> {
+    let Some(&nf) = s.first() else {
+        return Err("polyhedron without a face stream".into());
+    };
+    if nf == 0 {
+        return Err("polyhedron with 0 faces".into());
+    }
+    let mut pos = 1;
+    for f in 0..nf as usize {
+        let Some(&len) = s.get(pos) else {
+            return Err(format!("polyhedron face stream ends after {f} of {nf} faces ({} values)", s.len()));
+        };
+        let len = len as usize;
+        if len < 3 {
+            return Err(format!("polyhedron face {f} has {len} points; a face needs at least 3"));
+        }
+        let Some(ids) = s.get(pos + 1..pos + 1 + len) else {
+            return Err(format!(
+                "polyhedron face {f} announces {len} points but the face stream ends after {} values",
+                s.len()
+            ));
+        };
+        if let Some(&bad) = ids.iter().find(|&&i| i as usize >= n_points) {
+            return Err(format!(
+                "polyhedron face {f} refers to point {bad}, but there are {n_points} points"
+            ));
+        }
+        pos += 1 + len;
+    }
+    if pos != s.len() {
+        return Err(format!("polyhedron face stream has {} values, its {nf} faces use {pos}", s.len()));
+    }
+    Ok(())
 }
 
 /// Reads a VTK file by extension: `.vtk` (legacy), `.vtu`, `.vts`, `.vtr`, `.vti` (XML).

@@ -531,7 +531,7 @@ fn polyhedra(
         // faceoffsets[i] = end of cell i's stream in `faces`, −1 for non-polyhedra.
         let mut start = 0usize;
         for i in 0..n {
-            let end = fo[i];
+            let end = *fo.get(i).ok_or_else(bad)?;
             if end < 0 {
                 continue;
             }
@@ -780,5 +780,34 @@ mod tests {
         let ds = parse(vtu.as_bytes(), Path::new("p.vtu")).unwrap();
         assert_eq!(ds.poly_faces[0][0], 4);
         assert_eq!(ds.poly_faces[0].len(), 17);
+    }
+
+    #[test]
+    fn malformed_polyhedra_are_refused_not_panicking() {
+        // The unit tetrahedron of `rectilinear_and_polyhedron` as a polyhedron with a broken face stream.
+        let vtu = |faces: &str, faceoffsets: &str| {
+            format!("<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\"><Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points><Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">42</DataArray><DataArray type=\"Int32\" Name=\"faces\" format=\"ascii\">{faces}</DataArray><DataArray type=\"Int32\" Name=\"faceoffsets\" format=\"ascii\">{faceoffsets}</DataArray></Cells></Piece></UnstructuredGrid></VTKFile>")
+        };
+        let err = |faces: &str, offs: &str| {
+            let e = parse(vtu(faces, offs).as_bytes(), Path::new("p.vtu")).unwrap_err().to_string();
+            assert!(e.contains("p.vtu"), "{e}");
+            e
+        };
+        // A face refers to point 9 of 4 (used to panic in the decomposition).
+        let e = err("4 3 0 2 9 3 0 1 3 3 1 2 3 3 0 3 2", "17");
+        assert!(e.contains("cell 0") && e.contains("point 9") && e.contains("4 points"), "{e}");
+        // Five faces announced, four given.
+        let e = err("5 3 0 2 1 3 0 1 3 3 1 2 3 3 0 3 2", "17");
+        assert!(e.contains("ends after 4 of 5 faces"), "{e}");
+        // A face announcing more points than the stream holds.
+        let e = err("4 3 0 2 1 3 0 1 3 3 1 2 3 7 0 3 2", "17");
+        assert!(e.contains("announces 7 points"), "{e}");
+        // Trailing values after the last face.
+        let e = err("3 3 0 2 1 3 0 1 3 3 1 2 3 3 0 3 2", "17");
+        assert!(e.contains("has 17 values"), "{e}");
+        // A two-point face, and an empty faceoffsets array (used to index out of bounds).
+        let e = err("4 2 0 2 3 0 1 3 3 1 2 3 3 0 3 2", "16");
+        assert!(e.contains("face 0 has 2 points"), "{e}");
+        err("4 3 0 2 1 3 0 1 3 3 1 2 3 3 0 3 2", "");
     }
 }

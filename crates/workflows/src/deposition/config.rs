@@ -247,8 +247,19 @@ impl Validate for DepositionConfig {
         }
         for (i, b) in self.bodies.iter().enumerate() {
             c.element("bodies", i, |c| {
-                if b.name.trim().is_empty() {
+                // The name becomes a file name in the run folder (`bodies/<name>.vtu`, `<name>_deposit.png`).
+                if b.name.is_empty() {
                     c.fail("name", "name must not be empty");
+                } else if !b.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "_.-".contains(ch))
+                    || b.name.chars().all(|ch| ch == '.')
+                {
+                    c.fail(
+                        "name",
+                        format!(
+                            "name = \"{}\" may only hold letters A–Z, a–z, digits and `_` `.` `-` (it names output files)",
+                            b.name
+                        ),
+                    );
                 }
                 c.file_exists("file", &b.file);
                 c.positive("scale", b.scale);

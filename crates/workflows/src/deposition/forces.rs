@@ -3,6 +3,7 @@
 //! accelerations the force library gives at the reference state.
 
 use super::config::ForcesConfig;
+use spatter_core::check::{Checker, Invalid};
 use spatter_core::control::Finished;
 use spatter_flow::forces::ranking::{physical_magnitudes, reference_terms, Ranking, RankingInput};
 use spatter_io::run::{RunContext, RunSummary};
@@ -83,8 +84,19 @@ fn write_csv(path: &std::path::Path, r: &Ranking) -> std::io::Result<()> {
     spatter_io::csv::write_table(path, &h, &rows)
 }
 
+/// Why a `forces` run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ForcesError {
+    #[error("invalid forces configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
+    Invalid(Vec<Invalid>),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
 /// Runs a `forces` scenario: writes `force_ranking.csv` and `force_magnitudes.csv`, returns the table.
-pub fn run(cfg: &ForcesConfig, ctx: &RunContext) -> Result<RunSummary, std::io::Error> {
+/// The configuration is validated first (scenario files already are; a Rust caller may not have).
+pub fn run(cfg: &ForcesConfig, ctx: &RunContext) -> Result<RunSummary, ForcesError> {
+    Checker::run(cfg, None).map_err(ForcesError::Invalid)?;
     let (refs, phys) = rankings(cfg);
     let a = ctx.dir.path("force_ranking.csv");
     write_csv(&a, &refs)?;
@@ -129,5 +141,17 @@ mod tests {
         let v: f64 = crit.split(',').nth(4).unwrap().parse().unwrap();
         assert!((v - 9.90).abs() < 0.005, "{crit}");
         assert!(s.headline.iter().any(|l| l.contains("F_S0")));
+    }
+
+    #[test]
+    fn forces_run_refuses_an_invalid_configuration() {
+        let dir = tempfile::tempdir().unwrap();
+        let rd = spatter_io::run::RunDir::create(dir.path()).unwrap();
+        let ctx = RunContext { dir: &rd, control: &spatter_core::control::Unattended, resume: false };
+        let mut cfg = table_6_4();
+        cfg.velocity_scale = 0.0;
+        let e = run(&cfg, &ctx).unwrap_err().to_string();
+        assert!(e.contains("velocity_scale_m_s"), "{e}");
+        assert!(!dir.path().join("force_ranking.csv").exists());
     }
 }

@@ -14,6 +14,7 @@
 
 use super::config::{DepositionConfig, PictureQuantity};
 use serde::{Deserialize, Serialize};
+use spatter_core::check::{Checker, Invalid};
 use spatter_core::control::Finished;
 use spatter_core::mesh::TriMesh;
 use spatter_core::{Aabb, Vec3};
@@ -48,11 +49,17 @@ pub enum DepositionError {
     Io(#[from] std::io::Error),
     #[error("checkpoint: {0}")]
     Checkpoint(String),
+    #[error("cannot resume: {0}")]
+    Resume(String),
+    #[error("invalid deposition configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
+    Invalid(Vec<Invalid>),
 }
 
 /// What `checkpoint.bin` holds.
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
+    /// The configuration that wrote it (JSON), compared on resume.
+    config: String,
     state: TrackerState,
     injectors: Vec<InjectorState>,
     next_output: u64,
@@ -70,6 +77,12 @@ const BALANCE_COLUMNS: [&str; 9] = [
     "escaped_kg",
     "balance_residual_kg",
 ];
+
+/// The configuration as stored in (and compared with) the checkpoint. The scenario folder is not part
+/// of it, so a run folder can be resumed after the scenario moved.
+fn config_json(cfg: &DepositionConfig) -> String {
+    serde_json::to_string(cfg).unwrap_or_default()
+}
 
 /// Builds the flow field of `cfg`.
 pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
@@ -153,6 +166,10 @@ fn write_parcels(tr: &Tracker<Field>, ctx: &RunContext, k: u64, pvd: &mut PvdSer
 
 /// Runs a deposition scenario.
 pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, DepositionError> {
+    // Scenario files are validated by the loader; a configuration built in Rust is checked here (a zero
+    // dt_s would otherwise mean u64::MAX steps).
+    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DepositionError::Invalid)?;
+    let config = config_json(cfg);
     let field = build_field(cfg)?;
     let bodies = build_bodies(cfg, &field)?;
     let settings = TrackSettings {
@@ -179,12 +196,13 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     let ckpt = ctx.dir.checkpoint_path();
     let mut next_output = 0u64;
     let (mut csv, mut pvd) = if ctx.resume && ckpt.is_file() {
-        let c: Checkpoint =
-            spatter_io::checkpoint::load(&ckpt).map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
-        if c.injectors.len() != injectors.len() || c.state.deposits.len() != tr.bodies.len() {
-            return Err(DepositionError::Checkpoint(
-                "the checkpoint was written by a scenario with other injectors or bodies".into(),
-            ));
+        let c: Checkpoint = spatter_io::checkpoint::load(&ckpt)
+            .map_err(|e| DepositionError::Checkpoint(format!("{}: {e}", ckpt.display())))?;
+        if c.config != config {
+            return Err(DepositionError::Resume(format!(
+                "{} was written by a different configuration; start afresh without --resume",
+                ckpt.display()
+            )));
         }
         tr.state = c.state;
         for (inj, st) in injectors.iter_mut().zip(&c.injectors) {
@@ -220,6 +238,7 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
         if ctx.control.stop_requested() {
             csv.flush()?;
             let c = Checkpoint {
+                config: config.clone(),
                 state: tr.state.clone(),
                 injectors: injectors.iter().map(Injector::state).collect(),
                 next_output,

@@ -121,15 +121,69 @@ fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
         );
     }
     assert!(!b.join("checkpoint.bin").exists());
-    // Something stuck and something bounced.
+    // Something stuck and something bounced: the plate saw more impacts than parcels stuck to it.
     let vtu = spatter_io::vtu::read(&a.join("bodies/plate.vtu")).unwrap();
-    let _ = vtu;
+    let impacts: f64 = vtu.cell_data["impacts"].1.iter().sum();
+    let deposited_mass: f64 = vtu.cell_data["deposited_mass_kg"].1.iter().sum();
+    let balance = std::fs::read_to_string(a.join("balance.csv")).unwrap();
+    let last: Vec<f64> = balance.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    let stuck_parcels = last[2];
+    assert!(stuck_parcels > 0.0 && deposited_mass > 0.0, "nothing stuck");
+    assert!(impacts > stuck_parcels, "nothing bounced: {impacts} impacts, {stuck_parcels} parcels stuck");
+    // The body file and the summary agree on the deposited mass.
     let summary = std::fs::read_to_string(a.join("deposit_summary.csv")).unwrap();
     let row: Vec<&str> = summary.lines().nth(1).unwrap().split(',').collect();
     let deposited: f64 = row[1].parse().unwrap();
-    let impacts: u64 = row[3].parse().unwrap();
-    assert!(deposited > 0.0 && impacts > 0);
+    assert!((deposited - deposited_mass).abs() <= 1e-12 * deposited, "{deposited} vs {deposited_mass}");
+    assert_eq!(row[3].parse::<f64>().unwrap(), impacts);
     assert!(a.join("plate_deposit.png").is_file());
+}
+
+#[test]
+fn resuming_with_another_configuration_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = scenario(dir.path());
+    let out = dir.path().join("run");
+    let s = run_in(&cfg, &out, &StopAfterPolls::new(20), false);
+    assert_eq!(s.finished, spatter_core::control::Finished::Interrupted);
+    let mut other = cfg.clone();
+    other.time.dt_s = 2.5e-4;
+    let rd = RunDir::create(&out).unwrap();
+    let ctx = RunContext { dir: &rd, control: &Unattended, resume: true };
+    let e = run(&other, &ctx).unwrap_err().to_string();
+    assert!(e.contains("checkpoint.bin") && e.contains("different configuration"), "{e}");
+    // The checkpoint is left for the right configuration.
+    assert!(out.join("checkpoint.bin").is_file());
+    let s = run_in(&cfg, &out, &Unattended, true);
+    assert_eq!(s.finished, spatter_core::control::Finished::Completed);
+}
+
+#[test]
+fn a_rust_caller_gets_the_validation_too() {
+    // dt_s = 0 used to give duration/dt = ∞ → u64::MAX steps: an endless run.
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = scenario(dir.path());
+    cfg.time.dt_s = 0.0;
+    let rd = RunDir::create(&dir.path().join("run")).unwrap();
+    let ctx = RunContext { dir: &rd, control: &Unattended, resume: false };
+    let e = run(&cfg, &ctx).unwrap_err();
+    assert!(matches!(e, super::DepositionError::Invalid(_)), "{e}");
+    assert!(e.to_string().contains("dt_s = 0 must be a positive number (time.dt_s)"), "{e}");
+}
+
+#[test]
+fn body_names_cannot_leave_the_run_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = scenario(dir.path());
+    for bad in ["../../x", "a/b", "..", "plate one", ""] {
+        cfg.bodies[0].name = bad.into();
+        let errs = spatter_core::check::Checker::run(&cfg, Some(dir.path())).unwrap_err();
+        assert!(errs.iter().any(|e| e.key == "bodies[0].name"), "{bad}: {errs:?}");
+    }
+    for good in ["plate", "wedge_v2.stl-body", "A.1"] {
+        cfg.bodies[0].name = good.into();
+        assert!(spatter_core::check::Checker::run(&cfg, Some(dir.path())).is_ok(), "{good}");
+    }
 }
 
 #[test]
