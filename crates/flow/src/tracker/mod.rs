@@ -136,6 +136,10 @@ pub struct TrackerState {
     pub deposits: Vec<Deposit>,
     pub balance: Balance,
     pub next_id: u64,
+    /// Parcels at this index and beyond are not airborne (set by [`Tracker::sort_parcels`], which puts the
+    /// airborne ones first, and by [`Tracker::add`]); the step loop stops here, so deposited and escaped
+    /// parcels cost nothing once sorted out.
+    pub live_end: usize,
 }
 
 /// A run that cannot continue.
@@ -253,6 +257,7 @@ impl<F: FlowField> Tracker<F> {
             self.state.histories.push(h);
         }
         self.state.parcels.push(parcel);
+        self.state.live_end = self.state.parcels.len();
     }
 
     /// Whether parcels carry a [`ParcelExtra`].
@@ -261,7 +266,8 @@ impl<F: FlowField> Tracker<F> {
         self.settings.dispersion.is_some() || s.magnus || s.rotational_torque.is_some()
     }
 
-    /// Reorders the parcels: airborne ones first, by location cell, then by id (deterministic).
+    /// Reorders the parcels: airborne ones first, by location cell, then by id (deterministic); the
+    /// step loop then ends at the last airborne parcel.
     pub fn sort_parcels(&mut self) {
         let ps = &self.state.parcels;
         let mut order: Vec<u32> = (0..ps.len() as u32).collect();
@@ -278,15 +284,17 @@ impl<F: FlowField> Tracker<F> {
             let e = &self.state.extras;
             self.state.extras = order.iter().map(|&i| e[i as usize].clone()).collect();
         }
+        self.state.live_end = self.state.parcels.iter().take_while(|p| p.status == Status::Airborne).count();
     }
 
     /// Advances every airborne parcel by one step.
     pub fn step(&mut self) -> Result<(), TrackError> {
         let every = self.settings.resort_interval as u64;
-        if every > 0 && self.state.step % every == 0 && self.field.tet_hint_count() > 0 {
+        if every > 0 && self.state.step % every == 0 {
             self.sort_parcels();
         }
-        let n_chunks = self.state.parcels.len().div_ceil(CHUNK);
+        let live = self.state.live_end.min(self.state.parcels.len());
+        let n_chunks = live.div_ceil(CHUNK);
         if self.events.len() < n_chunks {
             self.events.resize_with(n_chunks, Vec::new);
             self.errors.resize_with(n_chunks, || None);
@@ -307,7 +315,7 @@ impl<F: FlowField> Tracker<F> {
         // One loop per combination of side arrays (rayon's zip needs them all present).
         macro_rules! chunks {
             ($extras:expr, $hist:expr, $body:expr) => {
-                st.parcels
+                st.parcels[..live]
                     .par_chunks_mut(CHUNK)
                     .zip($extras)
                     .zip($hist)
@@ -343,18 +351,18 @@ impl<F: FlowField> Tracker<F> {
         match (st.extras.is_empty(), st.histories.is_empty()) {
             (true, true) => chunks!(none_e(), none_h(), |c, e, h, v, r| run(c, e, h, v, r, &ctx, step)),
             (false, true) => {
-                chunks!(st.extras.par_chunks_mut(CHUNK).map(Some), none_h(), |c, e, h, v, r| run(
+                chunks!(st.extras[..live].par_chunks_mut(CHUNK).map(Some), none_h(), |c, e, h, v, r| run(
                     c, e, h, v, r, &ctx, step
                 ))
             }
             (true, false) => {
-                chunks!(none_e(), st.histories.par_chunks_mut(CHUNK).map(Some), |c, e, h, v, r| run(
+                chunks!(none_e(), st.histories[..live].par_chunks_mut(CHUNK).map(Some), |c, e, h, v, r| run(
                     c, e, h, v, r, &ctx, step
                 ))
             }
             (false, false) => chunks!(
-                st.extras.par_chunks_mut(CHUNK).map(Some),
-                st.histories.par_chunks_mut(CHUNK).map(Some),
+                st.extras[..live].par_chunks_mut(CHUNK).map(Some),
+                st.histories[..live].par_chunks_mut(CHUNK).map(Some),
                 |c, e, h, v, r| run(c, e, h, v, r, &ctx, step)
             ),
         }
