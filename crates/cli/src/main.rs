@@ -65,7 +65,9 @@ enum Command {
         threads: Option<usize>,
     },
     /// Run the registered reference cases and print a table of errors; non-zero exit on any failure.
-    #[command(after_help = "Examples:\n  spatter validate --quick\n  spatter validate --case chung_ooi")]
+    #[command(
+        after_help = "Examples:\n  spatter validate --quick\n  spatter validate --case chung_ooi\n  spatter validate --csv validation.csv"
+    )]
     Validate {
         /// Reduced variants (the ones CI runs).
         #[arg(long)]
@@ -73,6 +75,9 @@ enum Command {
         /// Only cases whose name contains this text.
         #[arg(long)]
         case: Option<String>,
+        /// Also write the table with every check's source to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
     },
     /// Rank the particle–fluid forces of a `forces` scenario: table on screen, CSV in the output folder.
     #[command(after_help = "Example:\n  spatter forces examples/forces_table_6_4.toml --out runs/forces")]
@@ -103,7 +108,7 @@ fn main() -> ExitCode {
         }
         Command::Check { scenario } => commands::check(&scenario),
         Command::Demo { out, threads } => commands::run::demo(&out, threads),
-        Command::Validate { quick, case } => commands::validate(quick, case.as_deref()),
+        Command::Validate { quick, case, csv } => commands::validate(quick, case.as_deref(), csv.as_deref()),
         Command::Bench { engine, quick } => commands::bench(&engine, quick),
         Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
     };

@@ -37,8 +37,9 @@ pub fn check(path: &Path) -> Result<ExitCode> {
     }
 }
 
-/// `spatter validate`: run the registered cases and print one line per compared quantity.
-pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
+/// `spatter validate`: run the registered cases and print one line per compared quantity; with `csv`,
+/// also write the table (with each check's source) to that file.
+pub fn validate(quick: bool, filter: Option<&str>, csv: Option<&Path>) -> Result<ExitCode> {
     let cases: Vec<_> = registry::validation_cases()
         .into_iter()
         .filter(|c| filter.is_none_or(|f| c.name.contains(f)))
@@ -51,6 +52,7 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
         "case", "quantity", "reference", "ours", "rel.error", "tolerance"
     );
     let (mut passed, mut failed) = (0, 0);
+    let mut rows = Vec::new();
     for case in cases {
         for c in (case.run)(quick) {
             let tol = match c.tolerance {
@@ -58,6 +60,21 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
                 Tolerance::Absolute(t) => format!("±{:.1e}", t),
             };
             let ok = c.passed();
+            let (kind, t) = match c.tolerance {
+                Tolerance::Relative(t) => ("relative", t),
+                Tolerance::Absolute(t) => ("absolute", t),
+            };
+            rows.push(vec![
+                c.case.clone(),
+                c.quantity.clone(),
+                format!("{:e}", c.reference),
+                format!("{:e}", c.ours),
+                format!("{:e}", c.error()),
+                kind.to_owned(),
+                format!("{t:e}"),
+                if ok { "pass" } else { "fail" }.to_owned(),
+                c.source.clone(),
+            ]);
             if ok {
                 passed += 1
             } else {
@@ -76,6 +93,22 @@ pub fn validate(quick: bool, filter: Option<&str>) -> Result<ExitCode> {
         }
     }
     println!("\n{passed} passed, {failed} failed{}", if quick { " (quick variants)" } else { "" });
+    if let Some(path) = csv {
+        let header = [
+            "case",
+            "quantity",
+            "reference",
+            "ours",
+            "error",
+            "tolerance_kind",
+            "tolerance",
+            "result",
+            "source",
+        ];
+        spatter_io::csv::write_table(path, &header, &rows)
+            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        println!("table with sources: {}", path.display());
+    }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
