@@ -20,6 +20,10 @@ pub struct BenchResult {
     pub wall_particles: usize,
     pub steps: u64,
     pub seconds: f64,
+    /// CPU seconds (user + system, all threads of the process) of the timed steps, when the operating
+    /// system reports them (Linux `/proc/self/stat`); on a shared machine this is the fair measure of
+    /// work, wall time the measure of speed.
+    pub cpu_seconds: Option<f64>,
     pub particle_steps_per_s: f64,
     pub interactions_per_s: f64,
     pub interactions_per_particle: f64,
@@ -64,12 +68,17 @@ pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, cra
         }
         let mut interactions = 0u64;
         let p0 = sim.phase_times();
+        let c0 = cpu_seconds();
         let t0 = Instant::now();
         for _ in 0..steps {
             sim.step()?;
             interactions += sim.last.interactions;
         }
         let seconds = t0.elapsed().as_secs_f64();
+        let cpu = match (c0, cpu_seconds()) {
+            (Some(a), Some(b)) => Some(b - a),
+            _ => None,
+        };
         let p1 = sim.phase_times();
         let ms = |a: f64, b: f64| (b - a) * 1e3 / steps as f64;
         let phase_ms = crate::sim::PhaseTimes {
@@ -87,6 +96,7 @@ pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, cra
             wall_particles: sim.boundary.len(),
             steps,
             seconds,
+            cpu_seconds: cpu,
             particle_steps_per_s: nf as f64 * steps as f64 / seconds,
             interactions_per_s: interactions as f64 / seconds,
             interactions_per_particle: interactions as f64 / (steps as f64 * nf as f64),
@@ -94,6 +104,18 @@ pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, cra
             phase_ms,
         })
     })
+}
+
+/// CPU time of this process \[s\] (user + system over all threads), from `/proc/self/stat` (fields 14
+/// and 15, in clock ticks of 1/100 s, the Linux `USER_HZ`). None where that file does not exist.
+pub fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count fields after the last ')'.
+    let rest = &s[s.rfind(')')? + 1..];
+    let mut f = rest.split_whitespace().skip(11);
+    let utime: f64 = f.next()?.parse().ok()?;
+    let stime: f64 = f.next()?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 /// Runs the benchmark on one and two threads and returns the lines to print.
@@ -106,22 +128,48 @@ pub fn bench(quick: bool) -> Result<Vec<String>, crate::SphError> {
         r1.fluid_particles, r1.wall_particles, r1.interactions_per_particle, steps
     )];
     for r in [&r1, &r2] {
+        let cpu = match r.cpu_seconds {
+            Some(c) if c > 0.0 => format!(
+                ", {:.3e} interactions per CPU-second ({:.2} CPU-s/step)",
+                r.interactions_per_particle * r.fluid_particles as f64 * r.steps as f64 / c,
+                c / r.steps as f64
+            ),
+            _ => String::new(),
+        };
         lines.push(format!(
-            "  {} thread(s): {:.3e} particle-steps/s, {:.3e} particle-interactions/s ({:.3e} per thread), {:.3} s/step",
+            "  {} thread(s): {:.3e} particle-steps/s, {:.3e} particle-interactions/s ({:.3e} per core), {:.3} s/step{}",
             r.threads,
             r.particle_steps_per_s,
             r.interactions_per_s,
             r.interactions_per_s / r.threads as f64,
-            r.seconds / r.steps as f64
+            r.seconds / r.steps as f64,
+            cpu
         ));
     }
-    lines.push(format!(
-        "  parallel efficiency on 2 threads: {:.1} %",
+    let mut eff = format!(
+        "  parallel efficiency on 2 threads (wall time): {:.1} %",
         100.0 * r2.particle_steps_per_s / (2.0 * r1.particle_steps_per_s)
-    ));
+    );
+    if let (Some(c1), Some(c2)) = (r1.cpu_seconds, r2.cpu_seconds) {
+        if c2 > 0.0 {
+            // Work efficiency: 1-thread CPU time over 2-thread CPU time for the same steps. Below 100 %
+            // only when the parallel scheme adds work; it says nothing about waiting for a busy core.
+            eff.push_str(&format!("; CPU-time ratio 1/2 threads: {:.1} %", 100.0 * c1 / c2));
+        }
+    }
+    lines.push(eff);
     lines.push(format!(
         "  memory: {:.0} bytes per fluid particle (state, scratch and walls)",
         r1.bytes_per_particle
+    ));
+    lines.push(format!(
+        "  phases, 1 thread [ms/step]: forces {:.0}, wall state {:.0}, sort {:.0}, walls and guard {:.0}, predict {:.0}, correct {:.0}",
+        r1.phase_ms.forces,
+        r1.phase_ms.wall_state,
+        r1.phase_ms.sort,
+        r1.phase_ms.walls_guard,
+        r1.phase_ms.predict,
+        r1.phase_ms.correct
     ));
     Ok(lines)
 }

@@ -5,6 +5,7 @@
 //! one contiguous range of the sorted arrays. Compared with the 3×3×3 block of support-sized cells this
 //! examines about 40 % fewer candidates.
 
+use rayon::prelude::*;
 use spatter_core::grid::CellGrid;
 use spatter_core::Vec3;
 use std::ops::Range;
@@ -25,6 +26,11 @@ fn floor(x: f64) -> f64 {
 pub struct NeighbourGrid {
     cells: CellGrid,
     support: f64,
+    /// Per cell: 1 when some point lies within `reach` cells along every axis (the block a query from
+    /// this cell can visit), else 0. Empty unless [`build_reach`](Self::build_reach) was called after the
+    /// last rebuild; then queries from cells with 0 return at once.
+    reach: Vec<u8>,
+    reach_tmp: Vec<u8>,
 }
 
 impl NeighbourGrid {
@@ -37,6 +43,59 @@ impl NeighbourGrid {
     pub fn rebuild(&mut self, pos: &[Vec3], support: f64) {
         self.support = support;
         self.cells.rebuild(pos, 0.5 * support);
+        self.reach.clear();
+    }
+
+    /// Cells a query reaches beyond its own along each axis: `ceil(support / cell size)`.
+    fn reach_cells(&self) -> usize {
+        (self.support / self.cells.cell_size()).ceil() as usize
+    }
+
+    /// Marks the cells from which a query can find a point (occupancy dilated by the query reach), so
+    /// that [`for_each_run`](Self::for_each_run) from empty regions costs one lookup instead of a stencil
+    /// (fluid particles far from every wall, dry wall particles). Valid until the next rebuild.
+    pub fn build_reach(&mut self) {
+        let [nx, ny, nz] = self.cells.dims();
+        let ncells = nx * ny * nz;
+        if self.cells.entries().is_empty() {
+            return;
+        }
+        let r = self.reach_cells();
+        let cells = &self.cells;
+        let layer = nx * ny;
+        let (tmp, out) = (&mut self.reach_tmp, &mut self.reach);
+        tmp.resize(ncells, 0);
+        out.resize(ncells, 0);
+        // Along x, from the cell starts (a prefix sum: cells a..=b of a row hold points when
+        // start(a) < end(b)), into `out`.
+        out.par_chunks_mut(nx).enumerate().for_each(|(row, o)| {
+            let base = row * nx;
+            for (x, v) in o.iter_mut().enumerate() {
+                let a = cells.cell_range(base + x.saturating_sub(r)).start;
+                let b = cells.cell_range(base + (x + r).min(nx - 1)).end;
+                *v = (a < b) as u8;
+            }
+        });
+        // Along y within each layer, into `tmp`.
+        let src = &*out;
+        tmp.par_chunks_mut(layer).enumerate().for_each(|(z, t)| {
+            let l = &src[z * layer..(z + 1) * layer];
+            for y in 0..ny {
+                let o = &mut t[y * nx..(y + 1) * nx];
+                o.iter_mut().for_each(|v| *v = 0);
+                for yy in y.saturating_sub(r)..(y + r + 1).min(ny) {
+                    or_into(o, &l[yy * nx..(yy + 1) * nx]);
+                }
+            }
+        });
+        // Along z, into `out`.
+        let src = &*tmp;
+        out.par_chunks_mut(layer).enumerate().for_each(|(z, o)| {
+            o.iter_mut().for_each(|v| *v = 0);
+            for zz in z.saturating_sub(r)..(z + r + 1).min(nz) {
+                or_into(o, &src[zz * layer..(zz + 1) * layer]);
+            }
+        });
     }
 
     /// Indices of the set in cell order.
@@ -64,10 +123,18 @@ impl NeighbourGrid {
         }
     }
 
-    /// Bytes held (point cells, permutation and cell starts).
+    /// Bytes held (point cells, permutation, cell starts and the grid's scatter cursors, reach flags).
     pub fn bytes(&self) -> usize {
         let [nx, ny, nz] = self.cells.dims();
-        self.cells.entries().len() * 8 + (nx * ny * nz + 1) * 4
+        self.cells.entries().len() * 8
+            + (nx * ny * nz + 1) * 8
+            + self.reach.capacity()
+            + self.reach_tmp.capacity()
+    }
+
+    /// Releases the scratch of [`build_reach`](Self::build_reach) (for grids built once).
+    pub fn release_scratch(&mut self) {
+        self.reach_tmp = Vec::new();
     }
 
     /// Number of points binned.
@@ -105,6 +172,20 @@ impl NeighbourGrid {
         let q = (p - self.cells.origin()) * inv;
         let r = self.support * inv;
         let [nx, ny, nz] = self.cells.dims();
+        if !after && !self.reach.is_empty() {
+            // Own cell of p, possibly outside the grid: a query from beyond `reach` cells finds nothing;
+            // otherwise the flag of the nearest grid cell covers its whole stencil.
+            let rc = self.reach_cells() as f64;
+            let (cx, cy, cz) = (floor(q.x), floor(q.y), floor(q.z));
+            let inside = |c: f64, n: usize| c >= -rc && c <= (n - 1) as f64 + rc;
+            if !(inside(cx, nx) && inside(cy, ny) && inside(cz, nz)) {
+                return;
+            }
+            let cl = |c: f64, n: usize| (c.max(0.0) as usize).min(n - 1);
+            if self.reach[(cl(cz, nz) * ny + cl(cy, ny)) * nx + cl(cx, nx)] == 0 {
+                return;
+            }
+        }
         let span = |c: f64, n: usize| -> Option<(usize, usize)> {
             let lo = floor(c - r);
             let hi = floor(c + r);
@@ -155,6 +236,11 @@ impl NeighbourGrid {
     }
 }
 
+#[inline]
+fn or_into(o: &mut [u8], a: &[u8]) {
+    o.iter_mut().zip(a).for_each(|(v, w)| *v |= *w);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,19 +252,33 @@ mod tests {
             s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        for flat in [false, true] {
+        for (flat, reach) in [(false, false), (true, false), (false, true), (true, true)] {
+            let y0 = if flat { 0.0 } else { 0.35 };
+            let hole = Vec3::new(0.5, y0, 0.25);
             let pts: Vec<Vec3> = (0..3000)
                 .map(|_| Vec3::new(rnd(), if flat { 0.0 } else { 0.7 * rnd() }, 0.5 * rnd()))
+                .filter(|p| (*p - hole).length() > 0.2)
                 .collect();
             let support = 0.09;
             let mut g = NeighbourGrid::new();
             g.rebuild(&pts, support);
-            // Include query points outside the cloud.
+            if reach {
+                g.build_reach();
+            }
+            // Include query points outside the cloud, some just within the support of its boundary, and
+            // points inside a hole of the cloud.
             let queries: Vec<Vec3> = pts
                 .iter()
                 .step_by(29)
                 .copied()
-                .chain([Vec3::new(-0.05, 0.1, 0.2), Vec3::splat(2.0)])
+                .chain([
+                    Vec3::new(-0.05, 0.1, 0.2),
+                    Vec3::new(-0.08, 0.1, 0.2),
+                    Vec3::new(0.5, 0.3, 0.58),
+                    Vec3::new(1.089, -0.05, 0.55),
+                    Vec3::splat(2.0),
+                ])
+                .chain((0..400).map(|k| Vec3::new(-0.2 + 0.0035 * k as f64, y0, -0.1 + 0.0018 * k as f64)))
                 .collect();
             for p in queries {
                 let mut found = Vec::new();

@@ -463,6 +463,8 @@ impl Simulation {
             let scratch = PermuteScratch { v3: &mut w.acc_new, f: &mut w.drho_new, u: &mut w.perm_u };
             self.fluid.permute(&w.perm_buf, scratch);
         }
+        // Dry wall particles skip their fluid query.
+        w.grid.build_reach();
         self.compute_pressure();
         self.build_fluid_images();
         self.build_wall_set();
@@ -583,6 +585,11 @@ impl Simulation {
             }
         }
         w.w_grid.rebuild(&w.w_pos, support);
+        // Fluid particles far from every wall skip their wall query.
+        w.w_grid.build_reach();
+        if !periodic && !b.any_moving() {
+            w.w_grid.release_scratch();
+        }
         let perm = w.w_grid.entries();
         w.w_tmp_u.clear();
         w.w_tmp_u.extend(perm.iter().map(|&i| w.w_src[i as usize]));
