@@ -14,11 +14,8 @@ use std::ops::Range;
 #[inline(always)]
 fn floor(x: f64) -> f64 {
     let t = x as i64 as f64;
-    if t > x {
-        t - 1.0
-    } else {
-        t
-    }
+    // Branch-free: the comparison becomes a mask (cmpltsd/andpd) instead of a jump.
+    t - ((t > x) as u8 as f64)
 }
 
 /// Cell list of one particle set, with the support radius it was built for.

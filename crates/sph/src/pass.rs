@@ -789,15 +789,21 @@ fn batch_pairs(
             b.ci[t] = cont + psi * irj;
             b.cj[t] = cont - psi * iri;
         }
-        // Scatter.
+        // Scatter. The home sums live in locals: kept in `st`, they would be stored and reloaded for every
+        // neighbour (the compiler cannot rule out that `out` aliases them).
+        let (mut ax, mut ay, mut az, mut di) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for (t, &j) in chunk.iter().enumerate() {
             let o = j as usize - offset;
             let a = Vec3::new(b.ax[t] as f64, b.ay[t] as f64, b.az[t] as f64);
-            st.ai += a;
+            ax += a.x;
+            ay += a.y;
+            az += a.z;
             out.acc[o] -= a;
-            st.di += b.ci[t] as f64;
+            di += b.ci[t] as f64;
             out.drho[o] += b.cj[t] as f64;
         }
+        st.ai += Vec3::new(ax, ay, az);
+        st.di += di;
     }
 }
 

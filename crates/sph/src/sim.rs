@@ -32,6 +32,7 @@ use serde::{Deserialize, Serialize};
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::{KinematicTree, Motion};
 use spatter_core::{Aabb, Vec3};
+use std::mem::take;
 
 /// Wall properties shared by every kind of part.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -616,11 +617,10 @@ impl Simulation {
         w.walls_built = true;
     }
 
-    /// Wall extrapolation only (probes and loads between steps).
-    fn wall_state_only(&mut self) {
-        let kernel = self.kernel();
-        let c = self.consts(self.dt);
-        let w = &mut self.work;
+    /// Read-only views of the fluid, its periodic images (both without surface normals) and the walls
+    /// (with whatever wall state `work` holds) for the neighbour passes.
+    fn views(&self) -> (FluidSet<'_>, FluidSet<'_>, WallSet<'_>) {
+        let w = &self.work;
         let fl = FluidSet {
             pos: &self.fluid.pos,
             vel: &self.fluid.vel,
@@ -646,26 +646,29 @@ impl Simulation {
             ref_pos: &self.boundary.ref_pos,
             ref_normal: &self.boundary.ref_normal,
             frames: &self.boundary.frames,
-            vvisc: &[],
-            rho: &[],
-            pr: &[],
-            irho: &[],
+            vvisc: &w.w_vvisc,
+            rho: &w.w_rho,
+            pr: &w.w_pr,
+            irho: &w.w_irho,
             vol: &w.w_vol,
             part: &w.w_part,
             grid: &w.w_grid,
         };
-        pass::wall_state(
-            &kernel,
-            &c,
-            wl,
-            fl,
-            gh,
-            &mut w.w_rho,
-            &mut w.w_pr,
-            &mut w.w_irho,
-            &mut w.w_vvisc,
-            &mut w.w_wet,
-        );
+        (fl, gh, wl)
+    }
+
+    /// Wall extrapolation only (probes and loads between steps). The output buffers are moved out of
+    /// `work` while the pass reads the views (no copy, no allocation).
+    fn wall_state_only(&mut self) {
+        let kernel = self.kernel();
+        let c = self.consts(self.dt);
+        let w = &mut self.work;
+        let (mut rho, mut pr, mut irho) = (take(&mut w.w_rho), take(&mut w.w_pr), take(&mut w.w_irho));
+        let (mut vvisc, mut wet) = (take(&mut w.w_vvisc), take(&mut w.w_wet));
+        let (fl, gh, wl) = self.views();
+        pass::wall_state(&kernel, &c, wl, fl, gh, &mut rho, &mut pr, &mut irho, &mut vvisc, &mut wet);
+        let w = &mut self.work;
+        (w.w_rho, w.w_pr, w.w_irho, w.w_vvisc, w.w_wet) = (rho, pr, irho, vvisc, wet);
     }
 
     /// Time step of the last step taken \[s\] (0 before the first).
@@ -689,82 +692,42 @@ impl Simulation {
         self.wall_state_only();
         self.work.times.wall_state += lap();
         let n = self.fluid.len();
-        let w = &mut self.work;
         let st_on = c.gamma_st > 0.0;
+        let (mut nrm, mut g_nrm) = (take(&mut self.work.nrm), take(&mut self.work.g_nrm));
         if st_on {
-            w.nrm.resize(n, Vec3::ZERO);
-            let fl = FluidSet {
-                pos: &self.fluid.pos,
-                vel: &self.fluid.vel,
-                rho: &self.fluid.rho,
-                pr: &w.pr,
-                irho: &w.irho,
-                nrm: &[],
-                grid: &w.grid,
-            };
-            let gh = FluidSet {
-                pos: &w.g_pos,
-                vel: &w.g_vel,
-                rho: &w.g_rho,
-                pr: &w.g_pr,
-                irho: &w.g_irho,
-                nrm: &[],
-                grid: &w.g_grid,
-            };
-            pass::normals(&kernel, &c, fl, gh, &mut w.nrm);
-            w.g_nrm.clear();
-            w.g_nrm.extend(w.g_src.iter().map(|&s| w.nrm[s as usize]));
+            nrm.resize(n, Vec3::ZERO);
+            let (fl, gh, _) = self.views();
+            pass::normals(&kernel, &c, fl, gh, &mut nrm);
+            g_nrm.clear();
+            g_nrm.extend(self.work.g_src.iter().map(|&s| nrm[s as usize]));
         }
-        w.acc_new.resize(n, Vec3::ZERO);
-        w.drho_new.resize(n, 0.0);
-        w.phi.resize(if c.drag.enabled { n } else { 0 }, 0.0);
+        let w = &mut self.work;
+        let (mut acc, mut drho, mut phi) = (take(&mut w.acc_new), take(&mut w.drho_new), take(&mut w.phi));
+        let (mut gradc, mut divr) = (take(&mut w.gradc), take(&mut w.divr));
+        let (mut near, mut shift) = (take(&mut self.fluid.near), take(&mut self.fluid.shift));
+        acc.resize(n, Vec3::ZERO);
+        drho.resize(n, 0.0);
+        phi.resize(if c.drag.enabled { n } else { 0 }, 0.0);
         let ns = if c.shift_a > 0.0 { n } else { 0 };
-        w.gradc.resize(ns, Vec3::ZERO);
-        w.divr.resize(ns, 0.0);
-        let (nrm, g_nrm): (&[Vec3], &[Vec3]) = if st_on { (&w.nrm, &w.g_nrm) } else { (&[], &[]) };
-        let fl = FluidSet {
-            pos: &self.fluid.pos,
-            vel: &self.fluid.vel,
-            rho: &self.fluid.rho,
-            pr: &w.pr,
-            irho: &w.irho,
-            nrm,
-            grid: &w.grid,
-        };
-        let gh = FluidSet {
-            pos: &w.g_pos,
-            vel: &w.g_vel,
-            rho: &w.g_rho,
-            pr: &w.g_pr,
-            irho: &w.g_irho,
-            nrm: g_nrm,
-            grid: &w.g_grid,
-        };
-        let wl = WallSet {
-            pos: &w.w_pos,
-            vel: &w.w_vel,
-            src: &w.w_src,
-            ref_pos: &self.boundary.ref_pos,
-            ref_normal: &self.boundary.ref_normal,
-            frames: &self.boundary.frames,
-            vvisc: &w.w_vvisc,
-            rho: &w.w_rho,
-            pr: &w.w_pr,
-            irho: &w.w_irho,
-            vol: &w.w_vol,
-            part: &w.w_part,
-            grid: &w.w_grid,
-        };
+        gradc.resize(ns, Vec3::ZERO);
+        divr.resize(ns, 0.0);
+        let (fl, gh, wl) = self.views();
+        let (fl, gh) =
+            if st_on { (FluidSet { nrm: &nrm, ..fl }, FluidSet { nrm: &g_nrm, ..gh }) } else { (fl, gh) };
         let out = FluidOut {
-            acc: &mut w.acc_new,
-            drho: &mut w.drho_new,
-            near: &mut self.fluid.near,
-            shift: &mut self.fluid.shift,
-            phi: &mut w.phi,
-            gradc: &mut w.gradc,
-            divr: &mut w.divr,
+            acc: &mut acc,
+            drho: &mut drho,
+            near: &mut near,
+            shift: &mut shift,
+            phi: &mut phi,
+            gradc: &mut gradc,
+            divr: &mut divr,
         };
         let st = pass::fluid_pass(&kernel, &c, fl, gh, wl, out);
+        (self.fluid.near, self.fluid.shift) = (near, shift);
+        let w = &mut self.work;
+        (w.nrm, w.g_nrm, w.acc_new, w.drho_new, w.phi, w.gradc, w.divr) =
+            (nrm, g_nrm, acc, drho, phi, gradc, divr);
         w.times.forces += lap();
         st
     }
@@ -1044,42 +1007,12 @@ impl Simulation {
         self.wall_state_only();
         let kernel = self.kernel();
         let c = self.consts(self.dt);
-        let w = &mut self.work;
-        w.w_load.resize(w.w_src.len(), Vec3::ZERO);
-        let fl = FluidSet {
-            pos: &self.fluid.pos,
-            vel: &self.fluid.vel,
-            rho: &self.fluid.rho,
-            pr: &w.pr,
-            irho: &w.irho,
-            nrm: &[],
-            grid: &w.grid,
-        };
-        let gh = FluidSet {
-            pos: &w.g_pos,
-            vel: &w.g_vel,
-            rho: &w.g_rho,
-            pr: &w.g_pr,
-            irho: &w.g_irho,
-            nrm: &[],
-            grid: &w.g_grid,
-        };
-        let wl = WallSet {
-            pos: &w.w_pos,
-            vel: &w.w_vel,
-            src: &w.w_src,
-            ref_pos: &self.boundary.ref_pos,
-            ref_normal: &self.boundary.ref_normal,
-            frames: &self.boundary.frames,
-            vvisc: &w.w_vvisc,
-            rho: &w.w_rho,
-            pr: &w.w_pr,
-            irho: &w.w_irho,
-            vol: &w.w_vol,
-            part: &w.w_part,
-            grid: &w.w_grid,
-        };
-        pass::wall_loads(&kernel, &c, wl, fl, gh, &mut w.w_load);
+        let mut load = take(&mut self.work.w_load);
+        load.resize(self.work.w_src.len(), Vec3::ZERO);
+        let (fl, gh, wl) = self.views();
+        pass::wall_loads(&kernel, &c, wl, fl, gh, &mut load);
+        self.work.w_load = load;
+        let w = &self.work;
         let mut loads = vec![PartLoad::default(); self.boundary.parts.len()];
         let centres: Vec<Vec3> = self
             .boundary
@@ -1108,25 +1041,7 @@ impl Simulation {
         self.gather_image_state();
         let kernel = self.kernel();
         let c = self.consts(self.dt);
-        let w = &self.work;
-        let fl = FluidSet {
-            pos: &self.fluid.pos,
-            vel: &self.fluid.vel,
-            rho: &self.fluid.rho,
-            pr: &w.pr,
-            irho: &w.irho,
-            nrm: &[],
-            grid: &w.grid,
-        };
-        let gh = FluidSet {
-            pos: &w.g_pos,
-            vel: &w.g_vel,
-            rho: &w.g_rho,
-            pr: &w.g_pr,
-            irho: &w.g_irho,
-            nrm: &[],
-            grid: &w.g_grid,
-        };
+        let (fl, gh, _) = self.views();
         pass::probe(&kernel, &c, fl, gh, x)
     }
 

@@ -399,23 +399,46 @@ pub fn sessile_drop_angles(quick: bool) -> Vec<Check> {
         let r = sessile_drop(&d).expect("sessile drop runs");
         angles.push(r.contact_angle_deg);
     }
+    angle_checks(case, &factors, &angles)
+}
+
+/// A check that passes when `lo ≤ value < hi`, written as the band check of [`Check`] (the quantity names
+/// the band): the reference column shows the centre of the band, the tolerance its half-width (shrunk by 1e-9 relative so that
+/// `value = hi` fails: the condition is strict).
+fn in_band(case: &str, quantity: String, value: f64, lo: f64, hi: f64, source: &str) -> Check {
+    let half = 0.5 * (hi - lo);
+    Check::absolute(case, quantity, lo + half, value, half * (1.0 - 1e-9), source)
+}
+
+/// The sessile-drop conditions for the angles `angles[k]` [deg] measured at the adhesion factors
+/// `factors[k]`: each step up in adhesion lowers θ (θ(f₂) − θ(f₁) in [−180°, 0°)), and θ at the last
+/// factor (1: the wall attracts like the liquid itself) is below 90° (θ in [0°, 90°)). The printed
+/// "ours" column holds the measured difference or angle.
+fn angle_checks(case: &str, factors: &[f64], angles: &[f64]) -> Vec<Check> {
     let mut checks = Vec::new();
     for k in 0..factors.len() - 1 {
-        checks.push(Check::absolute(
+        checks.push(in_band(
             case,
-            format!("increase of θ from adhesion {} to {} [deg]", factors[k], factors[k + 1]),
-            0.0,
-            (angles[k + 1] - angles[k]).max(0.0),
+            format!(
+                "θ({}) − θ({}) in [−180, 0): {:.1}° → {:.1}° [deg]",
+                factors[k + 1],
+                factors[k],
+                angles[k],
+                angles[k + 1]
+            ),
+            angles[k + 1] - angles[k],
+            -180.0,
             0.0,
             "contact angle decreases with adhesion",
         ));
     }
-    checks.push(Check::absolute(
+    let last = factors.len() - 1;
+    checks.push(in_band(
         case,
-        format!("θ above 90° at adhesion 1 (θ = {:.1}°) [deg]", angles[2]),
+        format!("θ({}) in [0, 90): wetted [deg]", factors[last]),
+        angles[last],
         0.0,
-        (angles[2] - 90.0).max(0.0),
-        0.0,
+        90.0,
         "a wall attracting like the liquid itself is wetted",
     ));
     checks
@@ -460,6 +483,22 @@ mod tests {
     #[test]
     fn dam_break_front_quick() {
         assert_all_pass(&dam_break_front(true));
+    }
+
+    #[test]
+    fn sessile_checks_fail_on_wrong_angles() {
+        let f = [0.5, 0.75, 1.0];
+        let ok = angle_checks("c", &f, &[103.0, 57.0, 18.0]);
+        assert!(ok.iter().all(|c| c.passed()));
+        // The printed values are the real difference and angle.
+        assert_eq!(ok[0].ours, -46.0);
+        assert_eq!(ok[2].ours, 18.0);
+        // Rising angle, equal angles (strict), and a non-wetting drop at adhesion 1.
+        let bad = angle_checks("c", &f, &[100.0, 120.0, 120.0]);
+        assert!(!bad[0].passed() && !bad[1].passed() && !bad[2].passed());
+        let edge = angle_checks("c", &f, &[100.0, 95.0, 90.0]);
+        assert!(edge[0].passed() && edge[1].passed() && !edge[2].passed(), "θ = 90° is not below 90°");
+        assert!(!angle_checks("c", &f, &[100.0, 60.0, f64::NAN])[2].passed());
     }
 
     #[test]
