@@ -7,7 +7,7 @@
 //! |---|---|---|
 //! | [`NormalLaw`] | [`Hooke`], [`Hertz`] | elastic normal force F_ne(δ), per-contact state, interaction range beyond touching, the damping stiffness S_n, the contact radius a, the force that caps Coulomb friction |
 //! | [`DampingLaw`] | [`RestitutionDamping`], [`NoDamping`] | normal and tangential dashpot coefficients γ_n, γ_t and the tensile-clamp convention |
-//! | [`TangentialLaw`] | [`Mindlin`], [`LinearHistory`], [`Frictionless`] | tangential force with history, Coulomb cap |
+//! | [`TangentialLaw`] | [`Mindlin`], [`MindlinVariant`], [`LinearHistory`], [`Frictionless`] | tangential force with history, Coulomb cap |
 //! | [`RollingLaw`] | [`ConstantTorque`], [`ViscousRolling`], [`NoRolling`] | rolling-resistance torque |
 //!
 //! [`Composed<N, D, T, R>`](Composed) glues one law of each kind into a [`ContactLaw`], the interface the
@@ -83,7 +83,8 @@ pub use normal::{Hertz, HertzParams, Hooke, HookeParams, HookeStiffness, NormalF
 pub use pair::{PairProps, PairTable};
 pub use rolling::{AnyRolling, ConstantTorque, NoRolling, RollingLaw, ViscousRolling};
 pub use tangential::{
-    Frictionless, LinearHistory, Mindlin, MindlinParams, SpringHistory, TangentialForce, TangentialLaw,
+    Frictionless, LinearHistory, Mindlin, MindlinHistory, MindlinParams, MindlinVariant, SpringHistory,
+    TangentialForce, TangentialLaw,
 };
 
 use serde::de::DeserializeOwned;

@@ -49,17 +49,22 @@ pub trait TangentialLaw: Clone + Debug + Send + Sync + 'static {
 ///
 /// 1. ξ is rotated into the current tangent plane keeping its length (the contact frame turns with the
 ///    pair; projecting without rescaling would silently lose stored energy, rescaling keeps ½k_t|ξ|²);
-/// 2. ξ ← ξ + v_t Δt, trial force F = −k_t ξ − γ_t v_t;
+/// 2. ξ ← s ξ + v_t Δt with the law's history scale s, trial force F = −k_t ξ − γ_t v_t;
 /// 3. if |F| > μ F_c: F ← μ F_c F/|F| and ξ ← −F/k_t (the spring carries the capped force, no dashpot
 ///    while sliding, as LIGGGHTS), so a sliding contact stores exactly (μF_c)²/(2k_t) and can never push
 ///    along the sliding direction afterwards.
 ///
-/// Shared by [`Mindlin`] (k_t = 8 G* a) and [`LinearHistory`] (k_t ∝ k_n).
+/// The scale s says how the stored force follows a stiffness change k_prev → k_t (contact radius
+/// a_prev → a for Mindlin): with s = 1 the force is k_t ξ, i.e. it follows the stiffness both ways; with
+/// s = k_prev/k_t the force is kept and only the increment k_t Δξ is added (incremental form). See
+/// [`MindlinHistory`] for the four combinations. Shared by [`Mindlin`], [`MindlinVariant`] and
+/// [`LinearHistory`].
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn spring_history(
     xi: &mut Vec3,
     k_prev: &mut f64,
+    scale: f64,
     k_t: f64,
     gamma_t: f64,
     mu: f64,
@@ -84,7 +89,7 @@ fn spring_history(
     }
     // Energy stored at the end of the previous step (with the stiffness of then; the rotation keeps |ξ|).
     let u_old = 0.5 * *k_prev * len2;
-    x += v_t * dt;
+    x = x * scale + v_t * dt;
     let mut f = -k_t * x - gamma_t * v_t;
     let cap = mu * f_coulomb;
     let f2 = f.length_squared();
@@ -113,6 +118,58 @@ fn spring_history(
     TangentialForce { force: f, dissipated, energy }
 }
 
+/// Implements [`TangentialLaw`] for a spring-with-history law from its stiffness k_t(params, normal force)
+/// and its history scale s(k_t/k_t,prev) (see [`spring_history`]): the laws differ only in these two.
+macro_rules! spring_law {
+    ($law:ty, |$l:ident, $p:ident, $nf:ident| $stiffness:expr, |$l2:ident, $ratio:ident| $scale:expr) => {
+        impl TangentialLaw for $law {
+            type Params = MindlinParams;
+            type State = SpringHistory;
+
+            fn params(&self, _pair_index: usize, props: &PairProps) -> MindlinParams {
+                MindlinParams { g_star: props.g_star, mu: props.friction }
+            }
+
+            #[inline(always)]
+            fn stiffness(&self, $p: &MindlinParams, $nf: &NormalForce, _c: &ContactInput) -> f64 {
+                let $l = self;
+                $stiffness
+            }
+
+            #[inline(always)]
+            fn force(
+                &self,
+                p: &MindlinParams,
+                s: &mut SpringHistory,
+                k_t: f64,
+                gamma_t: f64,
+                f_coulomb: f64,
+                v_t: Vec3,
+                c: &ContactInput,
+                energy: bool,
+            ) -> TangentialForce {
+                let $l2 = self;
+                // k_t/k_t,prev = a/a_prev for Mindlin (1 at first touch and when either is zero).
+                let $ratio = if s.k_prev > 0.0 && k_t > 0.0 { k_t / s.k_prev } else { 1.0 };
+                let scale = $scale;
+                spring_history(
+                    &mut s.xi,
+                    &mut s.k_prev,
+                    scale,
+                    k_t,
+                    gamma_t,
+                    p.mu,
+                    f_coulomb,
+                    v_t,
+                    c.normal,
+                    c.dt,
+                    energy,
+                )
+            }
+        }
+    };
+}
+
 /// Mindlin (no-slip) tangential stiffness k_t = 8 G* a with history and Coulomb cap μ.
 ///
 /// Reference: Mindlin (1949) J. Appl. Mech. 16:259; Chung & Ooi (2011) §2; LAMMPS `tangential mindlin`.
@@ -136,34 +193,7 @@ pub struct SpringHistory {
     pub k_prev: f64,
 }
 
-impl TangentialLaw for Mindlin {
-    type Params = MindlinParams;
-    type State = SpringHistory;
-
-    fn params(&self, _pair_index: usize, props: &PairProps) -> MindlinParams {
-        MindlinParams { g_star: props.g_star, mu: props.friction }
-    }
-
-    #[inline(always)]
-    fn stiffness(&self, p: &MindlinParams, nf: &NormalForce, _c: &ContactInput) -> f64 {
-        8.0 * p.g_star * nf.contact_radius
-    }
-
-    #[inline(always)]
-    fn force(
-        &self,
-        p: &MindlinParams,
-        s: &mut SpringHistory,
-        k_t: f64,
-        gamma_t: f64,
-        f_coulomb: f64,
-        v_t: Vec3,
-        c: &ContactInput,
-        energy: bool,
-    ) -> TangentialForce {
-        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt, energy)
-    }
-}
+spring_law!(Mindlin, |_law, p, nf| 8.0 * p.g_star * nf.contact_radius, |_law, _ratio| 1.0);
 
 /// Linear tangential spring k_t = `stiffness_ratio` × S_n (S_n = k_n for Hooke) with history and Coulomb
 /// cap. LIGGGHTS `hooke` uses ratio 1 (or 2/7 with `ktToKnUser`).
@@ -178,34 +208,7 @@ impl Default for LinearHistory {
     }
 }
 
-impl TangentialLaw for LinearHistory {
-    type Params = MindlinParams;
-    type State = SpringHistory;
-
-    fn params(&self, _pair_index: usize, props: &PairProps) -> MindlinParams {
-        MindlinParams { g_star: props.g_star, mu: props.friction }
-    }
-
-    #[inline(always)]
-    fn stiffness(&self, _p: &MindlinParams, nf: &NormalForce, _c: &ContactInput) -> f64 {
-        self.stiffness_ratio * nf.damping_stiffness
-    }
-
-    #[inline(always)]
-    fn force(
-        &self,
-        p: &MindlinParams,
-        s: &mut SpringHistory,
-        k_t: f64,
-        gamma_t: f64,
-        f_coulomb: f64,
-        v_t: Vec3,
-        c: &ContactInput,
-        energy: bool,
-    ) -> TangentialForce {
-        spring_history(&mut s.xi, &mut s.k_prev, k_t, gamma_t, p.mu, f_coulomb, v_t, c.normal, c.dt, energy)
-    }
-}
+spring_law!(LinearHistory, |law, _p, nf| law.stiffness_ratio * nf.damping_stiffness, |_law, _ratio| 1.0);
 
 /// No tangential force.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -237,3 +240,57 @@ impl TangentialLaw for Frictionless {
         TangentialForce::default()
     }
 }
+
+/// How a Mindlin spring's history follows a changing contact radius a (k_t = 8G*a). The four choices of
+/// LAMMPS `pair granular` (`mindlin`, `mindlin_rescale`, `mindlin/force`, `mindlin_rescale/force`).
+///
+/// With the stored elastic force F_e, stiffness k = 8G*a and a_prev the radius of the previous step:
+///
+/// | choice | F_e when a changes (before adding k Δξ) | energy over a closed load cycle |
+/// |---|---|---|
+/// | `Displacement` | F_e a/a_prev (both ways) | can be created: displace at small a, load normally, return |
+/// | `DisplacementRescaled` | F_e a/a_prev loading, F_e (a/a_prev)² unloading | can be created (same cycle) |
+/// | `Force` | kept | can be created: displace at large a, unload normally, return |
+/// | `ForceRescaled` | kept loading, F_e a/a_prev unloading | never created |
+///
+/// `ForceRescaled` is the no-slip limit (θ = 1) of the incremental Mindlin–Deresiewicz law as written by
+/// Thornton, Cummins & Cleary (2013) Powder Technol. 233:30, eq. 18 (ΔT = 8G*a Δδ_t; T scaled by a/a_prev
+/// when the normal load decreases); `DisplacementRescaled` follows Walton (personal communication cited
+/// by the LAMMPS documentation of `pair granular`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MindlinHistory {
+    /// F = k_t ξ with the total displacement ξ (LAMMPS `mindlin`, LIGGGHTS `tangential history`).
+    #[default]
+    Displacement,
+    /// ξ ← ξ a/a_prev when a shrinks (LAMMPS `mindlin_rescale`).
+    DisplacementRescaled,
+    /// Incremental force: F ← F + k_t Δξ (LAMMPS `mindlin/force`).
+    Force,
+    /// Incremental force, F ← F a/a_prev when a shrinks (LAMMPS `mindlin_rescale/force`).
+    ForceRescaled,
+}
+
+impl MindlinHistory {
+    /// The scale s of [`spring_history`] for the stiffness ratio r = k_t/k_prev = a/a_prev.
+    #[inline(always)]
+    pub fn scale(self, ratio: f64) -> f64 {
+        match self {
+            MindlinHistory::Displacement => 1.0,
+            MindlinHistory::DisplacementRescaled => ratio.min(1.0),
+            MindlinHistory::Force => 1.0 / ratio,
+            MindlinHistory::ForceRescaled => (1.0 / ratio).min(1.0),
+        }
+    }
+}
+
+/// Mindlin no-slip stiffness k_t = 8 G* a with a chosen [`MindlinHistory`] and Coulomb cap μ.
+/// `MindlinVariant { history: MindlinHistory::Displacement }` is [`Mindlin`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MindlinVariant {
+    pub history: MindlinHistory,
+}
+
+spring_law!(MindlinVariant, |_law, p, nf| 8.0 * p.g_star * nf.contact_radius, |law, ratio| law
+    .history
+    .scale(ratio));

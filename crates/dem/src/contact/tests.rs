@@ -225,3 +225,101 @@ fn constant_torque_rolling_stops_without_reversing() {
     let t_stop = 3.0 * inertia / (0.1 * r * f_n);
     assert!(((steps as f64) * dt - t_stop).abs() <= 2.0 * dt, "{} vs {t_stop}", steps as f64 * dt);
 }
+
+/// Work absorbed by a Mindlin spring (no dashpot, no sliding) over the cycle: displace by `d` along x at
+/// stiffness `k0`, change the stiffness to `k1` at rest, then move back until the force has vanished.
+fn stiffness_cycle(history: MindlinHistory, k0: f64, k1: f64, d: f64) -> f64 {
+    let law = MindlinVariant { history };
+    let p = MindlinParams { g_star: 1e9, mu: 1e9 };
+    let mut s = SpringHistory::default();
+    let (n, dt) = (20_000, 1e-6);
+    let v = d / (n as f64 * dt);
+    let c = input(1e-6, Vec3::ZERO, 1e-3, 1e-3, dt);
+    let mut absorbed = 0.0;
+    let mut step = |s: &mut SpringHistory, k: f64, vx: f64| {
+        let vt = Vec3::new(vx, 0.0, 0.0);
+        let t = law.force(&p, s, k, 0.0, 1e30, vt, &c, true);
+        absorbed += -t.force.dot(vt) * dt;
+        t.force.x
+    };
+    for _ in 0..n {
+        step(&mut s, k0, v);
+    }
+    for i in 1..=n {
+        step(&mut s, k0 + (k1 - k0) * i as f64 / n as f64, 0.0);
+    }
+    // Back until the spring no longer pulls towards −x (force on i along +x ≤ 0 means it still pulls).
+    for _ in 0..100 * n {
+        if step(&mut s, k1, -v / 10.0) >= 0.0 {
+            break;
+        }
+    }
+    absorbed
+}
+
+#[test]
+fn mindlin_history_rules_match_their_closed_form_cycle_energies() {
+    // Closed forms (linear spring, stiffness change at rest, see MindlinHistory's table): the work the
+    // contact absorbs over the cycle. Positive = dissipated, negative = energy created. Tolerance 1 %
+    // of ½k_hi d² (Riemann-sum error of the discrete cycle, O(1/n) with n = 20 000 steps per leg).
+    let (lo, hi, d) = (1e5, 3e5, 1e-6);
+    let half = |k: f64| 0.5 * k * d * d;
+    use MindlinHistory::*;
+    let cases = [
+        // (rule, k0 → k1, expected absorbed)
+        (Displacement, hi, lo, half(hi) - half(lo)),
+        (Displacement, lo, hi, half(lo) - half(hi)),
+        (DisplacementRescaled, hi, lo, half(hi) - half(lo) * (lo / hi).powi(2)),
+        (DisplacementRescaled, lo, hi, half(lo) - half(hi)),
+        (Force, hi, lo, half(hi) - half(hi) * hi / lo),
+        (Force, lo, hi, half(lo) - half(lo) * lo / hi),
+        (ForceRescaled, hi, lo, half(hi) - half(lo)),
+        (ForceRescaled, lo, hi, half(lo) - half(lo) * lo / hi),
+    ];
+    for (rule, k0, k1, expected) in cases {
+        let w = stiffness_cycle(rule, k0, k1, d);
+        assert!(
+            (w - expected).abs() < 0.01 * half(hi),
+            "{rule:?} {k0:e} → {k1:e}: absorbed {w:e} J, closed form {expected:e} J"
+        );
+    }
+    // Only the Thornton et al. (2013) rule never creates energy, whichever way the stiffness changes.
+    for rule in [Displacement, DisplacementRescaled, Force, ForceRescaled] {
+        let worst = stiffness_cycle(rule, hi, lo, d).min(stiffness_cycle(rule, lo, hi, d));
+        assert_eq!(worst >= -1e-3 * half(hi), rule == ForceRescaled, "{rule:?}: worst cycle {worst:e} J");
+    }
+}
+
+#[test]
+fn mindlin_variant_with_displacement_history_is_mindlin_bit_for_bit() {
+    // The folded spring-law code must give the default law exactly: an oblique impact, every step compared.
+    let props = PairProps::new(&glass(), &rigid(0.2), 0.3, 0.7);
+    let a: HertzMindlin = Composed::new(Hertz, RestitutionDamping::default(), Mindlin, NoRolling);
+    let v = MindlinVariant { history: MindlinHistory::Displacement };
+    let b = Composed::new(Hertz, RestitutionDamping::default(), v, NoRolling);
+    let (pa, pb) = (a.params(0, &props), b.params(0, &props));
+    let (mut sa, mut sb) = (Default::default(), Default::default());
+    for k in 0..400 {
+        let t = k as f64 / 400.0;
+        let overlap = 1e-6 * (PI * t).sin();
+        let vel = Vec3::new(0.3 * (3.0 * t).cos(), 0.1, -0.02 * (PI * t).cos());
+        let c = input(overlap, vel, 0.005, 1e-3, 1e-8);
+        assert_eq!(a.compute(&pa, &c, &mut sa), b.compute(&pb, &c, &mut sb), "step {k}");
+    }
+}
+
+#[test]
+fn rescaled_history_follows_the_contact_radius_only_when_it_shrinks() {
+    // ξ = 1 µm stored at k_prev; the next step has no motion. ForceRescaled keeps the force when k grows
+    // (scale k_prev/k) and scales it by a/a_prev when k shrinks (scale 1): exact arithmetic.
+    let law = MindlinVariant { history: MindlinHistory::ForceRescaled };
+    let p = MindlinParams { g_star: 1e9, mu: 10.0 };
+    let c = input(1e-6, Vec3::ZERO, 1e-3, 1e-3, 1e-6);
+    for (k_prev, k, f_expected) in [(2e5, 4e5, 0.2), (4e5, 2e5, 0.2), (4e5, 1e5, 0.1)] {
+        let mut s = SpringHistory { xi: Vec3::new(1e-6, 0.0, 0.0), k_prev };
+        let t = law.force(&p, &mut s, k, 0.0, 1e30, Vec3::ZERO, &c, false);
+        let f = if k > k_prev { k_prev * 1e-6 } else { k * 1e-6 };
+        assert!((f - f_expected).abs() < 1e-15);
+        assert!((t.force.x + f).abs() < 1e-12 * f, "{k_prev:e} → {k:e}: {} vs {}", t.force.x, -f);
+    }
+}

@@ -80,7 +80,9 @@ pub struct ContactConfig {
     /// … or the characteristic impact speed \[m/s\] from which k_n is derived.
     #[serde(default)]
     pub hooke_characteristic_speed_m_s: Option<f64>,
-    /// `mindlin` (default, k_t = 8G*a) or `linear` (k_t = ratio × k_n).
+    /// `mindlin` (default, k_t = 8G*a, F = k_t ξ), `mindlin_rescale`, `mindlin_force`,
+    /// `mindlin_rescale_force` (how the Mindlin history follows the contact radius, see
+    /// [`crate::contact::MindlinHistory`]) or `linear` (k_t = ratio × k_n).
     #[serde(default)]
     pub tangential: TangentialKind,
     /// k_t / k_n of the linear tangential spring (default 2/7).
@@ -148,7 +150,24 @@ pub enum NormalKind {
 pub enum TangentialKind {
     #[default]
     Mindlin,
+    MindlinRescale,
+    MindlinForce,
+    MindlinRescaleForce,
     Linear,
+}
+
+impl TangentialKind {
+    /// The Mindlin history rule of a Mindlin kind (`None` for `linear`).
+    pub fn mindlin_history(self) -> Option<crate::contact::MindlinHistory> {
+        use crate::contact::MindlinHistory as H;
+        match self {
+            TangentialKind::Mindlin => Some(H::Displacement),
+            TangentialKind::MindlinRescale => Some(H::DisplacementRescaled),
+            TangentialKind::MindlinForce => Some(H::Force),
+            TangentialKind::MindlinRescaleForce => Some(H::ForceRescaled),
+            TangentialKind::Linear => None,
+        }
+    }
 }
 
 /// Engine options.

@@ -4,7 +4,8 @@ use super::config::{NormalKind, SceneConfig, TangentialKind};
 use super::setup;
 use crate::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
 use crate::contact::{
-    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, RestitutionDamping,
+    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
+    RestitutionDamping,
 };
 use crate::error::DemError;
 use crate::insertion::{Injector, Region};
@@ -66,6 +67,15 @@ pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> 
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
             run_with(tracked(Composed::new(hooke, damping, linear, r), cfg), cfg, ctx)
+        }
+        // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
+        (NormalKind::Hertz, k) => {
+            let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
+            run_with(tracked(Composed::new(Hertz, damping, t, r), cfg), cfg, ctx)
+        }
+        (NormalKind::Hooke, k) => {
+            let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
+            run_with(tracked(Composed::new(hooke, damping, t, r), cfg), cfg, ctx)
         }
         (NormalKind::Jkr, _) => run_with(tracked(Composed::new(jkr, damping, Mindlin, r), cfg), cfg, ctx),
         (NormalKind::Dmt, _) => run_with(

@@ -1,6 +1,6 @@
 //! Single- and two-particle impacts through the full engine, for the verification cases.
 
-use crate::contact::{HertzMindlin, PairProps, PairTable};
+use crate::contact::{ContactLaw, PairProps, PairTable};
 use crate::particles::NewParticle;
 use crate::sim::{Settings, Simulation};
 use crate::walls::{MeshWall, Plane, Wall, WallShape};
@@ -79,8 +79,8 @@ fn table(a: &Material, b: &Material, mu: f64, e: f64) -> PairTable<PairProps> {
 /// A sphere (radius `r`, material `m`) hits the flat rigid wall z = 0 with velocity `v_n` normal and `v_t`
 /// tangential and spin `omega` (about the axis n × t̂ when given as a scalar through `spin_axis_tn`).
 #[allow(clippy::too_many_arguments)]
-pub fn wall_impact(
-    law: &HertzMindlin,
+pub fn wall_impact<L: ContactLaw>(
+    law: &L,
     m: &Material,
     r: f64,
     mu: f64,
@@ -97,7 +97,7 @@ pub fn wall_impact(
     let speed = (v_n * v_n + v_t * v_t).sqrt();
     let tc = spatter_core::timestep::hertz_time(mass, r, effective_modulus(m, &wall), v_n.max(1e-3 * speed));
     let dt = tc / steps_per_contact;
-    let mut sim = Simulation::new(*law, vec![m.clone(), wall], pairs, dt, Settings::default());
+    let mut sim = Simulation::new(law.clone(), vec![m.clone(), wall], pairs, dt, Settings::default());
     let l = 8.0 * r;
     let shape = match target {
         Target::Plane => WallShape::Plane(Plane::new(Vec3::ZERO, Vec3::Z)),
@@ -140,8 +140,8 @@ pub fn wall_impact(
 
 /// Two spheres collide head-on along x (particle 1 at −x moving +x). Returns the outcome of both.
 #[allow(clippy::too_many_arguments)]
-pub fn pair_impact(
-    law: &HertzMindlin,
+pub fn pair_impact<L: ContactLaw>(
+    law: &L,
     m1: &Material,
     m2: &Material,
     r1: f64,
@@ -164,7 +164,7 @@ pub fn pair_impact(
         vn,
     );
     let dt = tc / steps_per_contact;
-    let mut sim = Simulation::new(*law, vec![m1.clone(), m2.clone()], pairs, dt, Settings::default());
+    let mut sim = Simulation::new(law.clone(), vec![m1.clone(), m2.clone()], pairs, dt, Settings::default());
     let gap = 3.0 * dt * vn;
     let mut a = NewParticle::at(Vec3::new(-r1 - 0.5 * gap, 0.0, 0.0), r1, 0);
     a.vel = v1;
@@ -177,8 +177,8 @@ pub fn pair_impact(
     let mut out = Outcome::default();
     let mut touched = false;
     let max_steps = (20.0 * steps_per_contact) as usize + 100;
-    let i0 = |s: &Simulation<HertzMindlin>| s.particles.index_of(0).expect("particle 0");
-    let i1 = |s: &Simulation<HertzMindlin>| s.particles.index_of(1).expect("particle 1");
+    let i0 = |s: &Simulation<L>| s.particles.index_of(0).expect("particle 0");
+    let i1 = |s: &Simulation<L>| s.particles.index_of(1).expect("particle 1");
     for _ in 0..max_steps {
         sim.step().expect("validation impact must not blow up");
         if sim.last_evaluation().pair_contacts > 0 {
