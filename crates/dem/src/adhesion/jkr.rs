@@ -147,14 +147,20 @@ pub struct Jkr {
 impl Jkr {
     /// Derived JKR scales for E* \[Pa\], R* \[m\], Γ \[J/m²\] (all > 0).
     pub fn new(e_star: f64, r_star: f64, work_of_adhesion: f64) -> Self {
-        use std::f64::consts::PI;
-        let a0 = (9.0 * PI * work_of_adhesion * r_star * r_star / (2.0 * e_star)).cbrt();
+        let a0 = (9.0 * std::f64::consts::PI * work_of_adhesion * r_star * r_star / (2.0 * e_star)).cbrt();
+        Self::with_a0(e_star, r_star, work_of_adhesion, a0)
+    }
+
+    /// [`Jkr::new`] with the zero-load contact radius a₀ \[m\] already known (from an earlier `new` of the
+    /// same E*, R*, Γ): no cube root, the same numbers bit for bit.
+    #[inline]
+    pub fn with_a0(e_star: f64, r_star: f64, work_of_adhesion: f64, a0: f64) -> Self {
         Jkr {
             e_star,
             r_star,
             work_of_adhesion,
             a0,
-            pull_off_force: 1.5 * PI * work_of_adhesion * r_star,
+            pull_off_force: 1.5 * std::f64::consts::PI * work_of_adhesion * r_star,
             critical_overlap: a0 * a0 / (2.0 * CBRT_6 * r_star),
         }
     }

@@ -18,9 +18,8 @@
 //!   Eq. 25), or the Hertz force of the overlap (LIGGGHTS-PFM JKR), or the total normal force after
 //!   damping clamped at zero (the kernel's non-adhesive default).
 
-use super::dmt::Dmt;
 use super::jkr::{BreakCriterion, Jkr, JkrState};
-use super::sjkr::SimplifiedJkr;
+use super::pull_off::{ConstantPullOff, PullOff};
 use crate::contact::{ContactInput, NormalForce, NormalLaw, PairProps};
 use serde::{Deserialize, Serialize};
 
@@ -82,6 +81,18 @@ fn overlap_stiffness(e_star: f64, c: &ContactInput) -> f64 {
     2.0 * e_star * (c.r_eff * c.overlap.max(0.0)).sqrt()
 }
 
+/// Per-contact state of [`JkrLaw`]: the hysteresis state and the zero-load contact radius a₀ of this
+/// contact, computed once when the contact forms. R* is fixed for a contact between two given spheres (or
+/// a sphere and a wall), so the JKR scales need no cube root per force evaluation: F_c and δ_c follow from
+/// a₀ with a few multiplications ([`Jkr::with_a0`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct JkrContact {
+    /// Formed flag and Newton warm start.
+    pub hysteresis: JkrState,
+    /// a₀ \[m\] of this contact (0 until formed).
+    pub a0: f64,
+}
+
 /// Full hysteretic JKR normal law. With Γ = 0 in a pair it reduces to Hertz.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct JkrLaw {
@@ -95,7 +106,7 @@ pub struct JkrLaw {
 
 impl NormalLaw for JkrLaw {
     type Params = AdhesionParams;
-    type State = JkrState;
+    type State = JkrContact;
 
     fn params(&self, _pair_index: usize, props: &PairProps) -> AdhesionParams {
         adhesion_params(props)
@@ -110,7 +121,7 @@ impl NormalLaw for JkrLaw {
     }
 
     #[inline]
-    fn evaluate(&self, p: &AdhesionParams, c: &ContactInput, state: &mut JkrState) -> Option<NormalForce> {
+    fn evaluate(&self, p: &AdhesionParams, c: &ContactInput, state: &mut JkrContact) -> Option<NormalForce> {
         if p.work_of_adhesion <= 0.0 {
             // Hertz limit (Γ → 0: a₀, δ_c → 0).
             let d = c.overlap;
@@ -127,8 +138,20 @@ impl NormalLaw for JkrLaw {
                 energy: 0.4 * force * d,
             });
         }
-        let jkr = Jkr::new(p.e_star, c.r_eff, p.work_of_adhesion);
-        let ev = jkr.evaluate(c.overlap, self.break_criterion, state)?;
+        if !state.hysteresis.formed && c.overlap < 0.0 {
+            return None;
+        }
+        let jkr = if state.a0 > 0.0 {
+            Jkr::with_a0(p.e_star, c.r_eff, p.work_of_adhesion, state.a0)
+        } else {
+            let j = Jkr::new(p.e_star, c.r_eff, p.work_of_adhesion);
+            state.a0 = j.a0;
+            j
+        };
+        let Some(ev) = jkr.evaluate(c.overlap, self.break_criterion, &mut state.hysteresis) else {
+            *state = JkrContact::default();
+            return None;
+        };
         let damping_stiffness = match self.damping {
             JkrDamping::Overlap => overlap_stiffness(p.e_star, c),
             JkrDamping::ContactRadius => 2.0 * p.e_star * ev.contact_radius,
@@ -147,71 +170,64 @@ impl NormalLaw for JkrLaw {
     }
 }
 
-/// DMT normal law: Hertz minus 2πΓR* while the surfaces touch.
+/// DMT normal law: Hertz minus 2πΓR* while the surfaces touch ([`PullOff::Dmt`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct DmtLaw {
     /// Coulomb normal force (default F_ne + 2·2πΓR*).
     pub coulomb: AdhesiveCoulomb,
 }
 
-impl NormalLaw for DmtLaw {
-    type Params = AdhesionParams;
-    type State = ();
-
-    fn params(&self, _pair_index: usize, props: &PairProps) -> AdhesionParams {
-        adhesion_params(props)
-    }
-
-    #[inline]
-    fn evaluate(&self, p: &AdhesionParams, c: &ContactInput, _s: &mut ()) -> Option<NormalForce> {
-        let law = Dmt::new(p.e_star, c.r_eff, p.work_of_adhesion);
-        let force = law.force(c.overlap)?;
-        Some(NormalForce {
-            force,
-            damping_stiffness: overlap_stiffness(p.e_star, c),
-            contact_radius: (c.r_eff * c.overlap).sqrt(),
-            coulomb_force: self.coulomb.force(force, law.pull_off_force, p.e_star, c),
-            energy: law.energy(c.overlap).unwrap_or(0.0),
-        })
-    }
-
-    fn damping_exponent(&self) -> f64 {
-        1.5
-    }
-}
-
-/// Simplified JKR normal law: Hertz minus (3/2)πΓR* while the surfaces touch.
+/// Simplified JKR normal law: Hertz minus (3/2)πΓR* while the surfaces touch ([`PullOff::SimplifiedJkr`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SjkrLaw {
     /// Coulomb normal force (default F_ne + 2F_c).
     pub coulomb: AdhesiveCoulomb,
 }
 
-impl NormalLaw for SjkrLaw {
-    type Params = AdhesionParams;
-    type State = ();
-
-    fn params(&self, _pair_index: usize, props: &PairProps) -> AdhesionParams {
-        adhesion_params(props)
-    }
-
-    #[inline]
-    fn evaluate(&self, p: &AdhesionParams, c: &ContactInput, _s: &mut ()) -> Option<NormalForce> {
-        let law = SimplifiedJkr::new(p.e_star, c.r_eff, p.work_of_adhesion);
-        let force = law.force(c.overlap)?;
-        Some(NormalForce {
-            force,
-            damping_stiffness: overlap_stiffness(p.e_star, c),
-            contact_radius: (c.r_eff * c.overlap).sqrt(),
-            coulomb_force: self.coulomb.force(force, law.pull_off_force, p.e_star, c),
-            energy: law.energy(c.overlap).unwrap_or(0.0),
-        })
-    }
-
-    fn damping_exponent(&self) -> f64 {
-        1.5
-    }
+/// The force of a [`ConstantPullOff`] law of kind `kind` for one contact.
+#[inline]
+fn pull_off_force(
+    kind: PullOff,
+    coulomb: AdhesiveCoulomb,
+    p: &AdhesionParams,
+    c: &ContactInput,
+) -> Option<NormalForce> {
+    let law = ConstantPullOff::new(kind, p.e_star, c.r_eff, p.work_of_adhesion);
+    let force = law.force(c.overlap)?;
+    Some(NormalForce {
+        force,
+        damping_stiffness: overlap_stiffness(p.e_star, c),
+        contact_radius: (c.r_eff * c.overlap).sqrt(),
+        coulomb_force: coulomb.force(force, law.pull_off_force, p.e_star, c),
+        energy: law.energy(c.overlap).unwrap_or(0.0),
+    })
 }
+
+/// [`NormalLaw`] for a constant-pull-off law struct with a `coulomb` field.
+macro_rules! constant_pull_off_law {
+    ($law:ty, $kind:expr) => {
+        impl NormalLaw for $law {
+            type Params = AdhesionParams;
+            type State = ();
+
+            fn params(&self, _pair_index: usize, props: &PairProps) -> AdhesionParams {
+                adhesion_params(props)
+            }
+
+            #[inline]
+            fn evaluate(&self, p: &AdhesionParams, c: &ContactInput, _s: &mut ()) -> Option<NormalForce> {
+                pull_off_force($kind, self.coulomb, p, c)
+            }
+
+            fn damping_exponent(&self) -> f64 {
+                1.5
+            }
+        }
+    };
+}
+
+constant_pull_off_law!(DmtLaw, PullOff::Dmt);
+constant_pull_off_law!(SjkrLaw, PullOff::SimplifiedJkr);
 
 #[cfg(test)]
 mod tests {
@@ -266,7 +282,7 @@ mod tests {
         let r = 5e-6;
         let jkr = Jkr::new(props.e_star, r, 0.2);
         let c_neck = input(-0.5 * jkr.critical_overlap, r);
-        let mut s = JkrState { formed: true, y: 0.0 };
+        let mut s = JkrContact { hysteresis: JkrState { formed: true, y: 0.0 }, a0: 0.0 };
         let law = JkrLaw::default();
         let p = law.params(0, &props);
         let nf = law.evaluate(&p, &c_neck, &mut s).unwrap();
@@ -299,8 +315,38 @@ mod tests {
         let p = law.params(0, &props);
         assert_eq!(law.range(&p, 5e-6), 0.0);
         let d: f64 = 1e-8;
-        let nf = law.evaluate(&p, &input(d, 5e-6), &mut JkrState::default()).unwrap();
+        let nf = law.evaluate(&p, &input(d, 5e-6), &mut JkrContact::default()).unwrap();
         let hertz = 4.0 / 3.0 * props.e_star * (5e-6f64).sqrt() * d.powf(1.5);
         assert!((nf.force - hertz).abs() < 1e-12 * hertz);
+    }
+
+    #[test]
+    fn cached_scales_give_the_same_forces_bit_for_bit() {
+        // JkrContact keeps a₀ from the first evaluation; every later force must equal the one from JKR
+        // scales recomputed at each call (Jkr::new + Jkr::evaluate), exactly, through loading, the neck and
+        // the break (VERIFICATION.md JKR points are covered by the mechanics tests).
+        let props = ice_abs_props(0.2);
+        let law = JkrLaw::default();
+        let p = law.params(0, &props);
+        let r = 5e-6;
+        let jkr = Jkr::new(props.e_star, r, 0.2);
+        let (mut cached, mut fresh) = (JkrContact::default(), JkrState::default());
+        let mut broke = false;
+        for k in 0..400 {
+            let x = k as f64 / 100.0;
+            let delta = jkr.critical_overlap * (3.0 - (x - 2.0).abs() * 2.1);
+            let a = law.evaluate(&p, &input(delta, r), &mut cached);
+            let b = Jkr::new(props.e_star, r, 0.2).evaluate(delta, law.break_criterion, &mut fresh);
+            assert_eq!(a.map(|n| n.force), b.map(|e| e.force), "step {k}, δ = {delta}");
+            assert_eq!(a.map(|n| n.energy), b.map(|e| e.energy));
+            match a {
+                Some(_) => assert_eq!(cached.a0, jkr.a0),
+                None => {
+                    assert_eq!(cached, JkrContact::default(), "no state without contact");
+                    broke |= k > 200;
+                }
+            }
+        }
+        assert!(broke, "the path reaches below −δ_c");
     }
 }
