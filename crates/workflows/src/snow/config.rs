@@ -206,6 +206,16 @@ pub struct GridConfig {
     pub refine_interface: bool,
 }
 
+/// Largest number of impacts one run may ask for (grid points × angles, × cases in sensitivity mode; speeds
+/// × impacts per speed on the rough wall). Every impact keeps a record of about 150 bytes, so the cap
+/// bounds the memory of a run to a few hundred MB; the thesis map has 2300.
+pub const MAX_IMPACTS: u64 = 2_000_000;
+
+/// Product of job counts without overflow (saturating), for the cap checks.
+fn job_count(factors: &[usize]) -> u64 {
+    factors.iter().fold(1u64, |acc, &f| acc.saturating_mul(f as u64))
+}
+
 /// The velocity scale chosen for the thesis's normalised axes (see `docs/snow.md`, "Velocity
 /// normalisation").
 pub const THESIS_VELOCITY_SCALE: f64 = 16.0;
@@ -264,6 +274,11 @@ impl GridConfig {
         let (lo, hi) = self.speed_range();
         axis(lo, hi, self.normal_speeds, self.speed_spacing)
     }
+
+    /// Number of impacts of the grid: diameters × normal speeds × angles (saturating).
+    pub fn jobs(&self) -> u64 {
+        job_count(&[self.diameters, self.normal_speeds, self.angles_deg.len()])
+    }
 }
 
 impl Validate for GridConfig {
@@ -306,6 +321,19 @@ impl Validate for GridConfig {
         if self.angles_deg.is_empty() {
             c.fail("angles_deg", "angles_deg must list at least one angle (0 for normal impacts)");
         }
+        let jobs = self.jobs();
+        if jobs > MAX_IMPACTS {
+            let key = if self.normal_speeds >= self.diameters { "normal_speeds" } else { "diameters" };
+            c.fail(
+                key,
+                format!(
+                    "diameters × normal_speeds × angles_deg = {} × {} × {} = {jobs} impacts is above the cap of {MAX_IMPACTS} impacts per run",
+                    self.diameters,
+                    self.normal_speeds,
+                    self.angles_deg.len()
+                ),
+            );
+        }
         for (i, a) in self.angles_deg.iter().enumerate() {
             c.element("angles_deg", i, |c| c.in_range("", *a, 0.0, true, 89.0, true));
         }
@@ -344,6 +372,11 @@ impl Validate for BisectionConfig {
         }
         if let Some(v) = self.speed_high_m_s {
             c.positive("speed_high_m_s", v);
+        }
+        if let (Some(lo), Some(hi)) = (self.speed_low_m_s, self.speed_high_m_s) {
+            if hi <= lo {
+                c.fail("speed_high_m_s", format!("speed_high_m_s = {hi} must be above speed_low_m_s = {lo}"));
+            }
         }
         c.in_range("relative_tolerance", self.relative_tolerance, 1e-9, true, 0.5, true);
     }
@@ -529,9 +562,13 @@ impl Default for RoughWallConfig {
 impl RoughWallConfig {
     /// Normal speeds \[m/s\] for the velocity scale `scale` \[m/s\].
     pub fn speed_axis(&self, scale: f64) -> Vec<f64> {
-        let lo = self.normal_speed_min_m_s.unwrap_or(0.005 * scale);
-        let hi = self.normal_speed_max_m_s.unwrap_or(0.3 * scale);
+        let (lo, hi) = self.speed_range(scale);
         axis(lo, hi, self.normal_speeds, self.speed_spacing)
+    }
+
+    /// Lowest and highest normal speed \[m/s\] for the velocity scale `scale` \[m/s\].
+    pub fn speed_range(&self, scale: f64) -> (f64, f64) {
+        (self.normal_speed_min_m_s.unwrap_or(0.005 * scale), self.normal_speed_max_m_s.unwrap_or(0.3 * scale))
     }
 
     pub fn bed_thickness(&self) -> f64 {
@@ -550,6 +587,15 @@ impl Validate for RoughWallConfig {
         c.in_range("volume_fraction", self.volume_fraction, 0.0, false, 2.0, true);
         if let Some(v) = self.bed_thickness_m {
             c.positive("bed_thickness_m", v);
+            if v < self.bed_sphere_diameter_m {
+                c.fail(
+                    "bed_thickness_m",
+                    format!(
+                        "bed_thickness_m = {v} is below bed_sphere_diameter_m = {}: the bed must hold one layer",
+                        self.bed_sphere_diameter_m
+                    ),
+                );
+            }
         }
         if let Some(w) = self.bed_width_m {
             c.positive("bed_width_m", w);
@@ -573,6 +619,21 @@ impl Validate for RoughWallConfig {
         }
         if let Some(v) = self.normal_speed_max_m_s {
             c.positive("normal_speed_max_m_s", v);
+        }
+        let jobs = job_count(&[self.normal_speeds, self.impacts_per_speed]);
+        if jobs > MAX_IMPACTS {
+            let key = if self.normal_speeds >= self.impacts_per_speed {
+                "normal_speeds"
+            } else {
+                "impacts_per_speed"
+            };
+            c.fail(
+                key,
+                format!(
+                    "normal_speeds × impacts_per_speed = {} × {} = {jobs} impacts is above the cap of {MAX_IMPACTS} impacts per run",
+                    self.normal_speeds, self.impacts_per_speed
+                ),
+            );
         }
         c.in_range("confidence", self.confidence, 0.5, true, 1.0, false);
     }
@@ -696,6 +757,29 @@ impl Validate for SnowConfig {
         c.item("fit", &self.fit);
         c.item("sensitivity", &self.sensitivity);
         c.item("rough_wall", &self.rough_wall);
+        // The rough-wall speed defaults follow the grid's velocity scale, so the order is checked here.
+        let (lo, hi) = self.rough_wall.speed_range(self.grid.velocity_scale_m_s);
+        if lo > hi {
+            let key = if self.rough_wall.normal_speed_min_m_s.is_some() {
+                "rough_wall.normal_speed_min_m_s"
+            } else {
+                "rough_wall.normal_speed_max_m_s"
+            };
+            c.fail(key, format!("rough-wall speed range is inverted: normal_speed_min_m_s = {lo} is above normal_speed_max_m_s = {hi}"));
+        }
+        if self.mode == Mode::Sensitivity {
+            let jobs = self.grid.jobs().saturating_mul(self.sensitivity.cases.len() as u64);
+            if jobs > MAX_IMPACTS {
+                c.fail(
+                    "sensitivity.cases",
+                    format!(
+                        "{} cases × {} grid impacts = {jobs} impacts is above the cap of {MAX_IMPACTS} impacts per run",
+                        self.sensitivity.cases.len(),
+                        self.grid.jobs()
+                    ),
+                );
+            }
+        }
         c.item("single", &self.single);
     }
 }

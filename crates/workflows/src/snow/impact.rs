@@ -26,6 +26,7 @@
 //!   criterion: the normal overlap persists) and, under [`StickCriterion::StaticTangential`], the contact
 //!   point also does not slide.
 
+use super::bed_index::{sweep_hit, BedIndex};
 use serde::{Deserialize, Serialize};
 use spatter_core::Vec3;
 use spatter_dem::contact::{ContactInput, ContactLaw};
@@ -110,8 +111,9 @@ pub enum Target<'a> {
     /// One sphere centred at the origin: frozen (infinite mass, a wall sphere) or free (particle–particle,
     /// initially at rest).
     Sphere { radius: f64, free_mass: Option<f64> },
-    /// A bed of frozen spheres below z = `top` (rough wall); the particle comes from above.
-    Bed { spheres: &'a [BedSphere], top: f64 },
+    /// A bed of frozen spheres below z = `top` (rough wall); the particle comes from above. `index` is the
+    /// cell list of `spheres` ([`BedIndex::new`]), built once per bed.
+    Bed { spheres: &'a [BedSphere], top: f64, index: &'a BedIndex },
 }
 
 /// One impact.
@@ -257,13 +259,26 @@ pub fn run_impact<L: ContactLaw>(
     let mut b = Bodies { x: x0, v: v0, w: Vec3::ZERO, xp: Vec3::ZERO, vp: Vec3::ZERO, wp: Vec3::ZERO };
 
     let mut slots: Vec<Slot<L::State>> = Vec::with_capacity(4);
-    let range_of = |rp: f64| law.range(params, if rp.is_infinite() { r } else { r * rp / (r + rp) });
+    let r_eff_of = |rp: f64| if rp.is_infinite() { r } else { r * rp / (r + rp) };
     let max_bed_radius = match target {
-        Target::Bed { spheres, .. } => spheres.iter().map(|q| q.radius).fold(0.0, f64::max),
+        Target::Bed { index, .. } => index.max_radius(),
         _ => 0.0,
     };
-    let bed_range = range_of(max_bed_radius.max(1e-300));
+    let bed_range = law.range(params, r_eff_of(max_bed_radius.max(1e-300)));
     let bed_reach = r + max_bed_radius + bed_range;
+    // Range and break energy depend on the partner radius only: computed once per distinct radius (every
+    // partner of a run usually has the same one), not per contact visit.
+    let per_radius = std::cell::Cell::new((f64::NAN, 0.0, 0.0));
+    let radius_consts = |rp: f64| -> (f64, f64) {
+        let (last, range, u_break) = per_radius.get();
+        if last == rp {
+            return (range, u_break);
+        }
+        let r_eff = r_eff_of(rp);
+        let v = (law.range(params, r_eff), break_energy(r_eff));
+        per_radius.set((rp, v.0, v.1));
+        v
+    };
 
     // Candidate bed spheres near the particle (a Verlet list with a skin of one bed-sphere diameter),
     // rebuilt when the particle has moved by half the skin.
@@ -279,8 +294,9 @@ pub fn run_impact<L: ContactLaw>(
         let mut l = Loads { active_overlap: f64::NEG_INFINITY, ..Loads::default() };
         let mut visit = |id: usize, g: Geom, slots: &mut Vec<Slot<L::State>>| {
             let pos = slots.iter().position(|sl| sl.id == id);
-            let r_eff = if g.r_partner.is_infinite() { r } else { r * g.r_partner / (r + g.r_partner) };
-            if pos.is_none() && g.overlap < -law.range(params, r_eff) {
+            let r_eff = r_eff_of(g.r_partner);
+            let (range, u_break) = radius_consts(g.r_partner);
+            if pos.is_none() && g.overlap < -range {
                 return;
             }
             let (partner_v, partner_w, i_eff) = match (free_mass, partner_inertia) {
@@ -307,7 +323,7 @@ pub fn run_impact<L: ContactLaw>(
             let idx = match pos {
                 Some(i) => i,
                 None => {
-                    slots.push(Slot { id, state: L::State::default(), u_break: break_energy(r_eff) });
+                    slots.push(Slot { id, state: L::State::default(), u_break });
                     slots.len() - 1
                 }
             };
@@ -342,17 +358,20 @@ pub fn run_impact<L: ContactLaw>(
                 let dist = d.length();
                 visit(0, Geom { n: d / dist, overlap: r + radius - dist, r_partner: radius }, slots);
             }
-            Target::Bed { spheres, .. } => {
+            Target::Bed { spheres, index, .. } => {
                 if (b.x - *lc).length() > 0.5 * list_skin {
+                    // Verlet list from the cell list: only the cells around the particle are searched.
                     *lc = b.x;
                     candidates.clear();
                     let reach = bed_reach + list_skin;
-                    for (i, q) in spheres.iter().enumerate() {
-                        let c = Vec3::from(q.centre);
-                        if (b.x - c).length_squared() < reach * reach {
+                    index.for_each_in_box(b.x - Vec3::splat(reach), b.x + Vec3::splat(reach), |i| {
+                        if (b.x - Vec3::from(spheres[i].centre)).length_squared() < reach * reach {
                             candidates.push(i);
                         }
-                    }
+                    });
+                    // Cell order differs from index order; visiting in index order keeps the results
+                    // independent of the search structure.
+                    candidates.sort_unstable();
                 }
                 for &i in candidates.iter() {
                     let q = spheres[i];
@@ -387,6 +406,7 @@ pub fn run_impact<L: ContactLaw>(
     };
     record(&mut trace, 0.0, &b, &loads, slots.len());
     let tracing = trace.is_some();
+    let mut flight: Option<FreeFlight> = None;
     let mut last_contact_time = 0.0;
     let mut t = 0.0;
     let max_steps = (s.check_time / dt).ceil().max(1.0) as u64;
@@ -444,7 +464,7 @@ pub fn run_impact<L: ContactLaw>(
                 decision = Decision::Bound;
                 break;
             }
-        } else if !tracing && receding(target, &b, r, bed_range) {
+        } else if !tracing && receding(target, &b, r, bed_range, &mut flight) {
             decision = Decision::Separated;
             break;
         }
@@ -479,42 +499,45 @@ pub fn run_impact<L: ContactLaw>(
     }
 }
 
+/// The first bed hit ahead of a particle in free flight: velocity and position when it was searched and
+/// the distance to it \[m\]. While the velocity stays the same (no contact, no force) and the particle has
+/// not yet covered that distance, the answer stands and the search is not repeated.
+#[derive(Clone, Copy)]
+struct FreeFlight {
+    v: Vec3,
+    x: Vec3,
+    hit: f64,
+}
+
 /// Whether a particle without contacts is moving away for good; `range` is the largest gap at which a
-/// bed contact can act.
-fn receding(target: Target<'_>, b: &Bodies, r: f64, range: f64) -> bool {
+/// bed contact can act. On a bed the straight path ahead is searched through the bed's cell list once per
+/// free flight (`flight` caches the result), so the cost does not grow with the bed.
+fn receding(target: Target<'_>, b: &Bodies, r: f64, range: f64, flight: &mut Option<FreeFlight>) -> bool {
     match target {
         Target::Plane => b.v.z > 0.0,
         Target::Sphere { .. } => (b.v - b.vp).dot(b.x - b.xp) > 0.0,
-        Target::Bed { spheres, top } => {
+        Target::Bed { spheres, top, index } => {
             if b.v.z <= 0.0 {
                 return false;
             }
             if b.x.z - r > top + range {
                 return true;
             }
+            if let Some(f) = *flight {
+                if f.v == b.v && (b.x - f.x).length() < f.hit {
+                    return false;
+                }
+            }
             // The straight path ahead must not come within range of any bed sphere.
-            let u = b.v.normalize();
-            spheres.iter().all(|q| {
-                let c = Vec3::from(q.centre);
-                sweep_hit(b.x, u, c, r + q.radius + range).is_none()
-            })
+            match index.first_hit(spheres, b.x, b.v.normalize(), r + range) {
+                None => true,
+                Some((hit, _)) => {
+                    *flight = Some(FreeFlight { v: b.v, x: b.x, hit });
+                    false
+                }
+            }
         }
     }
-}
-
-/// Distance s ≥ 0 along unit direction `u` from `o` at which a point comes within `rr` of `c`.
-fn sweep_hit(o: Vec3, u: Vec3, c: Vec3, rr: f64) -> Option<f64> {
-    let oc = o - c;
-    let bq = u.dot(oc);
-    let cq = oc.length_squared() - rr * rr;
-    if cq <= 0.0 {
-        return Some(0.0);
-    }
-    if bq >= 0.0 {
-        return None;
-    }
-    let disc = bq * bq - cq;
-    (disc >= 0.0).then(|| -bq - disc.sqrt())
 }
 
 /// Position of first touch along the approach path through the aim point.
@@ -530,21 +553,15 @@ fn start_position(target: Target<'_>, r: f64, aim: [f64; 2], v0: Vec3) -> Vec3 {
                 None => far,
             }
         }
-        Target::Bed { spheres, top } => {
+        Target::Bed { spheres, top, index } => {
             let u = v0.normalize();
             let lift = (top + 2.0 * r) / (-u.z).max(1e-3);
             let far = Vec3::new(aim[0], aim[1], 0.0) - u * lift;
-            let mut best: Option<(f64, Vec3, f64)> = None;
-            for q in spheres {
-                let c = Vec3::from(q.centre);
-                if let Some(s) = sweep_hit(far, u, c, r + q.radius) {
-                    if best.is_none_or(|(bs, _, _)| s < bs) {
-                        best = Some((s, c, r + q.radius));
-                    }
+            match index.first_hit(spheres, far, u, r) {
+                Some((s, i)) => {
+                    let q = spheres[i];
+                    touch(far + u * s, Vec3::from(q.centre), r + q.radius)
                 }
-            }
-            match best {
-                Some((s, c, rr)) => touch(far + u * s, c, rr),
                 None => Vec3::new(aim[0], aim[1], r),
             }
         }

@@ -1,6 +1,7 @@
 //! Snow adhesion: stick/bounce regime maps of dry snow grains hitting car plastics.
 
 pub mod bed;
+pub mod bed_index;
 pub mod bisection;
 pub mod config;
 pub mod fit;

@@ -1,6 +1,8 @@
 //! From the configuration to one impact: pair properties, the restitution of the run, the contact law
 //! (chosen once per call from the configuration, then monomorphised), time step and check time.
 
+use super::bed::Bed;
+use super::bed_index::BedIndex;
 use super::config::{ContactConfig, CorModulus, IntegrationConfig, NormalLawKind, TargetKind};
 use super::impact::{
     run_impact, BedSphere, DriverSettings, Impact, ImpactResult, Sphere, Target, TracePoint,
@@ -62,8 +64,15 @@ pub struct ImpactModel {
 pub enum Surface<'a> {
     /// The configured target (wall, wall sphere or free particle).
     Configured,
-    /// A bed of frozen wall-material spheres.
-    Bed { spheres: &'a [BedSphere], top: f64, sphere_radius: f64 },
+    /// A bed of frozen wall-material spheres with its cell list.
+    Bed { spheres: &'a [BedSphere], top: f64, sphere_radius: f64, index: &'a BedIndex },
+}
+
+impl<'a> Surface<'a> {
+    /// The rough-wall bed `bed` with its cell list `index` (`BedIndex::new(&bed.spheres)`).
+    pub fn bed(bed: &'a Bed, index: &'a BedIndex) -> Self {
+        Surface::Bed { spheres: &bed.spheres, top: bed.top, sphere_radius: bed.sphere_radius, index }
+    }
 }
 
 /// The numbers that set up one run, for logs and CSV files.
@@ -84,17 +93,25 @@ pub struct RunSetup {
 }
 
 impl ImpactModel {
+    /// Diameter \[m\] of the partner sphere of a `wall_sphere` or `particle` target for a particle of
+    /// diameter `d` (1 µm and `d` by default); infinite for the flat wall.
+    pub fn partner_diameter(&self, d: f64) -> f64 {
+        match self.target {
+            TargetKind::Wall => f64::INFINITY,
+            TargetKind::WallSphere => self.partner_diameter.unwrap_or(1e-6),
+            TargetKind::Particle => self.partner_diameter.unwrap_or(d),
+        }
+    }
+
     /// The pair (particle, partner) materials and partner radius/mass for diameter `d`.
     fn partner(&self, d: f64, surface: Surface<'_>) -> (Material, f64, Option<f64>) {
         match surface {
             Surface::Bed { sphere_radius, .. } => (self.wall.clone(), sphere_radius, None),
             Surface::Configured => match self.target {
                 TargetKind::Wall => (self.wall.clone(), f64::INFINITY, None),
-                TargetKind::WallSphere => {
-                    (self.wall.clone(), 0.5 * self.partner_diameter.unwrap_or(1e-6), None)
-                }
+                TargetKind::WallSphere => (self.wall.clone(), 0.5 * self.partner_diameter(d), None),
                 TargetKind::Particle => {
-                    let dp = self.partner_diameter.unwrap_or(d);
+                    let dp = self.partner_diameter(d);
                     let mp = self.particle.density * std::f64::consts::PI / 6.0 * dp * dp * dp;
                     (self.particle.clone(), 0.5 * dp, Some(mp))
                 }
@@ -167,7 +184,7 @@ impl ImpactModel {
         let (props, setup) = self.setup(d, v_n, surface);
         let (_, rp, mp) = self.partner(d, surface);
         let target = match surface {
-            Surface::Bed { spheres, top, .. } => Target::Bed { spheres, top },
+            Surface::Bed { spheres, top, index, .. } => Target::Bed { spheres, top, index },
             Surface::Configured => match self.target {
                 TargetKind::Wall => Target::Plane,
                 _ => Target::Sphere { radius: rp, free_mass: mp },

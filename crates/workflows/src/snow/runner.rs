@@ -8,6 +8,7 @@
 //! the same files as an uninterrupted one.
 
 use super::bed::{random_insertion, settled, wilson_interval, Bed};
+use super::bed_index::BedIndex;
 use super::bisection::{critical_speed, CriticalSpeed};
 use super::config::{Mode, Packing, SensitivityCase, SnowConfig};
 use super::material::TimeStepReport;
@@ -18,7 +19,6 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Invalid};
 use spatter_core::control::Finished;
-use spatter_core::material::effective_modulus;
 use spatter_core::rng::{seeded, RngExt};
 use spatter_core::Vec3;
 use spatter_dem::adhesion::tabor_parameter;
@@ -171,59 +171,99 @@ pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowErr
     Ok(summary)
 }
 
-/// Tabor parameter and time-step estimates at the smallest and largest diameter (printed for every run).
-pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
-    let (ds, v_max, partner_r) = match cfg.mode {
+/// The contact numbers printed for one diameter of a run: the effective quantities of the particle and the
+/// target it actually hits, and what follows from them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactReport {
+    /// Particle diameter \[m\].
+    pub diameter: f64,
+    /// Speed the Hertz time is quoted at \[m/s\] (the run's highest normal speed).
+    pub speed: f64,
+    /// E* of the particle–target pair \[Pa\].
+    pub e_star: f64,
+    /// R* = R₁R₂/(R₁ + R₂) \[m\] (R for the flat wall).
+    pub r_star: f64,
+    /// m* = m₁m₂/(m₁ + m₂) \[kg\] (m for a frozen target).
+    pub m_star: f64,
+    /// Tabor parameter at z₀ = 0.4 nm and 0.2 nm \[-\].
+    pub tabor: (f64, f64),
+    /// Thesis Eq. 24, Rayleigh and Hertz (at `speed`, with E*, R*, m*) time estimates \[s\].
+    pub times: TimeStepReport,
+    /// Time step the run uses \[s\].
+    pub dt: f64,
+}
+
+/// The target the run's impacts hit: the bed spheres in rough-wall mode, else the configured target.
+fn report_points(cfg: &SnowConfig) -> (Vec<f64>, f64, Option<f64>) {
+    match cfg.mode {
         Mode::RoughWall => {
             let v = cfg.rough_wall.speed_axis(cfg.grid.velocity_scale_m_s);
-            let d = cfg.rough_wall.particle_diameter_m;
-            (vec![d, d], v.last().copied().unwrap_or(1.0), Some(0.5 * cfg.rough_wall.bed_sphere_diameter_m))
+            (
+                vec![cfg.rough_wall.particle_diameter_m],
+                v.last().copied().unwrap_or(1.0),
+                Some(0.5 * cfg.rough_wall.bed_sphere_diameter_m),
+            )
         }
-        Mode::Single => {
-            let d = cfg.single.diameter_m;
-            (vec![d, d], cfg.single.normal_speed_m_s, None)
-        }
+        Mode::Single => (vec![cfg.single.diameter_m], cfg.single.normal_speed_m_s, None),
         _ => {
             let d = cfg.grid.diameter_axis();
-            (vec![d[0], d[d.len() - 1]], cfg.grid.speed_range().1, None)
+            let mut ds = vec![d[0]];
+            if d[d.len() - 1] != d[0] {
+                ds.push(d[d.len() - 1]);
+            }
+            (ds, cfg.grid.speed_range().1, None)
         }
-    };
-    let e_star = effective_modulus(&cfg.particle, &cfg.wall);
-    let mut out = Vec::new();
-    let g = cfg.contact.work_of_adhesion_j_m2;
-    let mut tabor = Vec::new();
-    let mut steps = Vec::new();
-    for &d in &[ds[0], ds[1]] {
-        let r = 0.5 * d;
-        let r_star = partner_r.map_or(r, |rp| r * rp / (r + rp));
-        let m = cfg.particle.density * std::f64::consts::PI / 6.0 * d.powi(3);
-        tabor.push((tabor_parameter(r_star, g, e_star, 0.4e-9), tabor_parameter(r_star, g, e_star, 0.2e-9)));
-        let model = model_of(cfg);
-        let surface = match partner_r {
-            Some(rp) => Surface::Bed { spheres: &[], top: 0.0, sphere_radius: rp },
-            None => Surface::Configured,
-        };
-        let (_, setup) = model.setup(d, v_max, surface);
-        steps.push((TimeStepReport::new(d, &cfg.particle, e_star, r_star, m, v_max), setup.dt));
     }
-    out.push(if ds[1] == ds[0] {
-        format!(
-            "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
-            tabor[0].0, tabor[0].1, ds[0]
-        )
-    } else {
-        format!(
-            "Tabor parameter (z0 = 0.4 / 0.2 nm): {:.3} / {:.3} at d = {:.3e} m, {:.3} / {:.3} at d = {:.3e} m (JKR valid above 5)",
-            tabor[0].0, tabor[0].1, ds[0], tabor[1].0, tabor[1].1, ds[1]
-        )
-    });
-    for (i, (t, dt)) in steps.iter().enumerate() {
-        if i == 1 && ds[1] == ds[0] {
-            break;
-        }
+}
+
+/// Contact numbers at the smallest and largest diameter of the run, for the target the impacts hit (flat
+/// wall, frozen wall sphere, free particle or rough-wall bed sphere). E*, R* and m* come from
+/// [`ImpactModel::setup`], the numbers the impacts use.
+pub fn contact_reports(cfg: &SnowConfig) -> Vec<ContactReport> {
+    let (ds, speed, bed_radius) = report_points(cfg);
+    let model = model_of(cfg);
+    let empty = BedIndex::default();
+    let surface = match bed_radius {
+        Some(rp) => Surface::Bed { spheres: &[], top: 0.0, sphere_radius: rp, index: &empty },
+        None => Surface::Configured,
+    };
+    let g = cfg.contact.work_of_adhesion_j_m2;
+    ds.iter()
+        .map(|&d| {
+            let (_, s) = model.setup(d, speed, surface);
+            ContactReport {
+                diameter: d,
+                speed,
+                e_star: s.e_star,
+                r_star: s.r_star,
+                m_star: s.m_star,
+                tabor: (
+                    tabor_parameter(s.r_star, g, s.e_star, 0.4e-9),
+                    tabor_parameter(s.r_star, g, s.e_star, 0.2e-9),
+                ),
+                times: TimeStepReport::new(d, &cfg.particle, s.e_star, s.r_star, s.m_star, speed),
+                dt: s.dt,
+            }
+        })
+        .collect()
+}
+
+/// Effective contact quantities, Tabor parameter and time-step estimates at the smallest and largest
+/// diameter (printed for every run).
+pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
+    let target = match cfg.mode {
+        Mode::RoughWall => "rough-wall bed sphere".to_string(),
+        _ => format!("{:?}", cfg.target),
+    };
+    let mut out = Vec::new();
+    for c in contact_reports(cfg) {
+        out.push(format!(
+            "contact at d = {:.3e} m with the {target}: E* = {:.5e} Pa, R* = {:.5e} m, m* = {:.5e} kg; Tabor parameter (z0 = 0.4 / 0.2 nm) {:.3} / {:.3} (JKR valid above 5)",
+            c.diameter, c.e_star, c.r_star, c.m_star, c.tabor.0, c.tabor.1
+        ));
         out.push(format!(
             "time steps at d = {:.3e} m: thesis Eq. 24 {:.4e} s, Rayleigh {:.4e} s, Hertz time at {:.3} m/s {:.4e} s; used {:.4e} s",
-            ds[i], t.thesis_eq24, t.rayleigh, v_max, t.hertz, dt
+            c.diameter, c.times.thesis_eq24, c.times.rayleigh, c.speed, c.times.hertz, c.dt
         ));
     }
     out
@@ -302,7 +342,12 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
             // The two impacts either side of the boundary at the smallest diameter, for ParaView.
             if let Some(b) = iface.brackets.first() {
                 let picks = [(b[0], b[1], "stick"), (b[0], b[2], "bounce")];
-                s.artifacts.extend(super::samples::write_sample_impacts(&model, &picks, ctx.dir)?);
+                s.artifacts.extend(super::samples::write_sample_impacts(
+                    &model,
+                    Surface::Configured,
+                    &picks,
+                    ctx.dir,
+                )?);
             }
         }
         let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
@@ -546,7 +591,8 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     let speeds = rw.speed_axis(cfg.grid.velocity_scale_m_s);
     let d = rw.particle_diameter_m;
     let model = model_of(cfg);
-    let surface = Surface::Bed { spheres: &bed.spheres, top: bed.top, sphere_radius: bed.sphere_radius };
+    let index = BedIndex::new(&bed.spheres);
+    let surface = Surface::bed(&bed, &index);
     let jobs: Vec<(usize, usize)> =
         (0..speeds.len()).flat_map(|i| (0..rw.impacts_per_speed).map(move |k| (i, k))).collect();
     let mut p = load_progress(cfg, ctx)?;

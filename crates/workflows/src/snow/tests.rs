@@ -101,7 +101,8 @@ fn rough_wall_start_touches_one_bed_sphere() {
     let cfg = SnowConfig::default();
     let bed = super::runner::make_bed(&cfg);
     let model = model_of(&cfg);
-    let surface = Surface::Bed { spheres: &bed.spheres, top: bed.top, sphere_radius: bed.sphere_radius };
+    let index = super::bed_index::BedIndex::new(&bed.spheres);
+    let surface = Surface::bed(&bed, &index);
     // Slow impacts on a 1 µm bed stick (single-asperity v_crit ≈ 0.95 m/s, digest §4.4), fast ones mostly
     // bounce; every run ends decided.
     let mut fast_bounces = 0;
@@ -336,4 +337,309 @@ fn sensitivity_checks_fail_on_doctored_counts() {
         k[i] = n;
         assert_eq!(failed(&k).len(), fails, "case {i} with {n} sticks: {:?}", failed(&k));
     }
+}
+
+#[test]
+fn material_report_uses_the_pair_of_each_target() {
+    // Hand computation (ice on ABS, thesis Table 2; Γ = 0.2 J/m²; highest grid speed 16 m/s):
+    // E*(ice–ABS) = 1.88329e9 Pa and E*(ice–ice) = 5.42095e9 Pa (digest §3.5); R* = R₁R₂/(R₁ + R₂);
+    // m* = m₁m₂/(m₁ + m₂), m(10 µm) = 4.81711e-13 kg (digest §3.5); Tabor (R*Γ²/(E*²z₀³))^{1/3}
+    // (9.587 / 19.173 on the wall at R = 5 µm, digest §3.5); Hertz time 2.868(m*²/(R*E*²v))^{1/5}
+    // (Chung & Ooi 2011). Reference values below computed independently of the code; tolerance 1e-5
+    // relative (the digest's printed digits: 1e-4).
+    let m10 = 4.817108735504351e-13;
+    // (target, setting, E*, R*, m*, Tabor 0.4 nm, Tabor 0.2 nm, Hertz time at 16 m/s) at d = 10 µm.
+    let rows = [
+        ("wall", TargetKind::Wall, 1.88329e9, 5e-6, m10, 9.586748675, 19.17349735, 4.366249314e-8),
+        (
+            "wall sphere 1 µm",
+            TargetKind::WallSphere,
+            1.88329e9,
+            4.545454545e-7,
+            m10,
+            4.310627022,
+            8.621254044,
+            7.053214106e-8,
+        ),
+        (
+            "equal particle",
+            TargetKind::Particle,
+            5.42095e9,
+            2.5e-6,
+            0.5 * m10,
+            3.760303332,
+            7.520606664,
+            2.490229955e-8,
+        ),
+    ];
+    let close = |a: f64, b: f64, tol: f64| ((a - b) / b).abs() < tol;
+    for (name, target, e, r, m, t4, t2, th) in rows {
+        for mode in [Mode::Grid, Mode::Single] {
+            let mut cfg = SnowConfig { mode, target, ..Default::default() };
+            cfg.single.diameter_m = 10e-6;
+            cfg.single.normal_speed_m_s = 16.0;
+            let reps = super::runner::contact_reports(&cfg);
+            assert_eq!(reps.len(), if mode == Mode::Grid { 2 } else { 1 });
+            let c = reps[0];
+            assert_eq!(c.diameter, 10e-6);
+            assert!(close(c.e_star, e, 1e-5), "{name}: E* {}", c.e_star);
+            assert!(close(c.r_star, r, 1e-9), "{name}: R* {}", c.r_star);
+            assert!(close(c.m_star, m, 1e-12), "{name}: m* {}", c.m_star);
+            assert!(close(c.tabor.0, t4, 1e-5) && close(c.tabor.1, t2, 1e-5), "{name}: {:?}", c.tabor);
+            assert!(close(c.times.hertz, th, 1e-5), "{name}: t_H {}", c.times.hertz);
+            // Particle-only estimates: Rayleigh 8.402 ns, thesis Eq. 24 0.129 ns at 10 µm (digest §2.7, §4.1).
+            assert!(close(c.times.rayleigh, 8.402e-9, 1e-3) && close(c.times.thesis_eq24, 0.129e-9, 4e-3));
+            // The time step used is the Hertz time of this pair at max(v, V_s,el) over 200 steps.
+            assert!(close(c.dt, th / 200.0, 1e-9), "{name}: dt {} vs {}", c.dt, th / 200.0);
+            let lines = super::runner::material_report(&cfg);
+            let text = lines.join("\n");
+            for v in [format!("{e:.5e}"), format!("{r:.5e}"), format!("{t4:.3}"), format!("{th:.4e}")] {
+                assert!(text.contains(&v), "{name}: `{v}` not printed in\n{text}");
+            }
+        }
+    }
+    // Rough wall: the contacts are with the 1 µm bed spheres (frozen, ABS), not the flat wall.
+    let cfg = SnowConfig { mode: Mode::RoughWall, ..Default::default() };
+    let reps = super::runner::contact_reports(&cfg);
+    assert_eq!(reps.len(), 1);
+    let c = reps[0];
+    assert!(close(c.e_star, 1.88329e9, 1e-5) && close(c.r_star, 4.545454545e-7, 1e-9));
+    assert!(close(c.m_star, m10, 1e-12) && close(c.tabor.0, 4.310627022, 1e-5));
+    // Highest rough-wall speed 0.3 × 16 = 4.8 m/s.
+    let th = 2.868 * (m10 * m10 / (4.545454545e-7 * 1.88329e9f64.powi(2) * 4.8)).powf(0.2);
+    assert!(close(c.times.hertz, th, 1e-4), "{} vs {th}", c.times.hertz);
+    // Largest grid diameter 100 µm on an equal particle: R* = 25 µm, Tabor 8.101 / 16.203.
+    let cfg = SnowConfig { target: TargetKind::Particle, ..Default::default() };
+    let c = super::runner::contact_reports(&cfg)[1];
+    assert_eq!(c.diameter, 100e-6);
+    assert!(close(c.r_star, 25e-6, 1e-12) && close(c.tabor.0, 8.101327944, 1e-5));
+}
+
+#[test]
+fn oversized_runs_are_refused_before_any_work() {
+    // A malformed scenario asking for 10⁹ impacts must be refused by the validation that `run` does first,
+    // naming the key and the cap (config::MAX_IMPACTS), instead of allocating the job list.
+    use super::config::MAX_IMPACTS;
+    let root = tempfile::tempdir().unwrap();
+    let dir = RunDir::create(root.path()).unwrap();
+    let ctx = RunContext { dir: &dir, control: &Unattended, resume: false };
+    let mut cfg = SnowConfig::default();
+    cfg.grid.diameters = 10_000;
+    cfg.grid.normal_speeds = 100_000;
+    let t = std::time::Instant::now();
+    let err = run(&cfg, &ctx).unwrap_err().to_string();
+    assert!(t.elapsed().as_secs_f64() < 1.0, "refused at once");
+    assert!(err.contains("grid.normal_speeds"), "{err}");
+    assert!(err.contains("1000000000 impacts") && err.contains(&MAX_IMPACTS.to_string()), "{err}");
+    // Counts that overflow 64 bits saturate instead of wrapping below the cap.
+    cfg.grid.diameters = usize::MAX;
+    cfg.grid.normal_speeds = usize::MAX;
+    let e = Checker::run(&cfg, None).unwrap_err();
+    assert!(e.iter().any(|i| i.key == "grid.normal_speeds" && i.message.contains("cap")), "{e:?}");
+    // Sensitivity: cases × grid; rough wall: speeds × impacts per speed.
+    let mut cfg = SnowConfig { mode: Mode::Sensitivity, ..Default::default() };
+    cfg.grid.diameters = 1000;
+    cfg.grid.normal_speeds = 1000;
+    let e = Checker::run(&cfg, None).unwrap_err();
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].key, "sensitivity.cases");
+    assert!(e[0].message.contains("9000000 impacts"), "{}", e[0].message);
+    let mut cfg = SnowConfig { mode: Mode::RoughWall, ..Default::default() };
+    cfg.rough_wall.impacts_per_speed = 1_000_000_000;
+    let err = run(&cfg, &ctx).unwrap_err().to_string();
+    assert!(err.contains("rough_wall.impacts_per_speed") && err.contains("cap of 2000000"), "{err}");
+    // Just at the cap is accepted.
+    let mut cfg = SnowConfig::default();
+    cfg.grid.diameters = 2000;
+    cfg.grid.normal_speeds = 1000;
+    assert!(Checker::run(&cfg, None).is_ok());
+}
+
+#[test]
+fn inverted_ranges_are_refused_with_the_key() {
+    let keys = |cfg: &SnowConfig| -> Vec<(String, String)> {
+        Checker::run(cfg, None).unwrap_err().into_iter().map(|i| (i.key, i.message)).collect()
+    };
+    // Rough wall: explicit min above explicit max.
+    let mut cfg = SnowConfig::default();
+    cfg.rough_wall.normal_speed_min_m_s = Some(3.0);
+    cfg.rough_wall.normal_speed_max_m_s = Some(1.0);
+    let k = keys(&cfg);
+    assert_eq!(k.len(), 1, "{k:?}");
+    assert_eq!(k[0].0, "rough_wall.normal_speed_min_m_s");
+    assert!(k[0].1.contains("inverted") && k[0].1.contains("= 3") && k[0].1.contains("= 1"), "{}", k[0].1);
+    // Only the minimum given, above the default maximum 0.3 × 16 = 4.8 m/s: the minimum is named.
+    let mut cfg = SnowConfig::default();
+    cfg.rough_wall.normal_speed_min_m_s = Some(5.0);
+    assert_eq!(keys(&cfg)[0].0, "rough_wall.normal_speed_min_m_s");
+    // Only the maximum given, below the default minimum 0.005 × 16 = 0.08 m/s: the maximum is named.
+    let mut cfg = SnowConfig::default();
+    cfg.rough_wall.normal_speed_max_m_s = Some(0.01);
+    assert_eq!(keys(&cfg)[0].0, "rough_wall.normal_speed_max_m_s");
+    // A bed thinner than one sphere.
+    let mut cfg = SnowConfig::default();
+    cfg.rough_wall.bed_thickness_m = Some(0.5e-6);
+    assert_eq!(keys(&cfg)[0].0, "rough_wall.bed_thickness_m");
+    // Bisection bracket and grid ranges.
+    let mut cfg = SnowConfig::default();
+    cfg.bisection.speed_low_m_s = Some(2.0);
+    cfg.bisection.speed_high_m_s = Some(1.0);
+    assert_eq!(keys(&cfg)[0].0, "bisection.speed_high_m_s");
+    let mut cfg = SnowConfig::default();
+    cfg.grid.normal_speed_min_m_s = Some(20.0);
+    assert_eq!(keys(&cfg)[0].0, "grid.normal_speed_max_m_s");
+    // Equal ends are a valid one-speed range.
+    let mut cfg = SnowConfig::default();
+    cfg.rough_wall.normal_speed_min_m_s = Some(1.0);
+    cfg.rough_wall.normal_speed_max_m_s = Some(1.0);
+    assert!(Checker::run(&cfg, None).is_ok());
+}
+
+/// Every value of a snow enum, by a match that stops compiling when a variant is added.
+fn all_names<T: serde::Serialize>(all: &[T]) -> Vec<String> {
+    all.iter().map(|v| serde_json::to_value(v).unwrap().as_str().unwrap().to_string()).collect()
+}
+
+#[test]
+fn example_comments_list_every_choice() {
+    // The `key = "value"  # a | b | c` comments of the snow examples must list exactly the values the code
+    // accepts (the regime-map example once omitted `single`).
+    use super::config::NormalLawKind;
+    let modes = [Mode::Grid, Mode::Bisection, Mode::Sensitivity, Mode::RoughWall, Mode::Single];
+    for m in modes {
+        match m {
+            Mode::Grid | Mode::Bisection | Mode::Sensitivity | Mode::RoughWall | Mode::Single => {}
+        }
+    }
+    let targets = [TargetKind::Wall, TargetKind::WallSphere, TargetKind::Particle];
+    for t in targets {
+        match t {
+            TargetKind::Wall | TargetKind::WallSphere | TargetKind::Particle => {}
+        }
+    }
+    let laws = [NormalLawKind::Jkr, NormalLawKind::Dmt, NormalLawKind::Sjkr, NormalLawKind::Hertz];
+    for l in laws {
+        match l {
+            NormalLawKind::Jkr | NormalLawKind::Dmt | NormalLawKind::Sjkr | NormalLawKind::Hertz => {}
+        }
+    }
+    let choices =
+        [("mode", all_names(&modes)), ("target", all_names(&targets)), ("normal_law", all_names(&laws))];
+    let examples = [
+        include_str!("../../../../examples/snow_regime_map.toml"),
+        include_str!("../../../../examples/snow_bisection.toml"),
+        include_str!("../../../../examples/snow_rough_wall.toml"),
+        include_str!("../../../../examples/snow_sensitivity.toml"),
+        include_str!("../../../../examples/snow_single.toml"),
+    ];
+    let mut seen = 0;
+    for text in examples {
+        for line in text.lines() {
+            let Some((code, comment)) = line.split_once('#') else { continue };
+            let Some((key, _)) = code.split_once('=') else { continue };
+            let Some((_, names)) = choices.iter().find(|(k, _)| *k == key.trim()) else { continue };
+            if !comment.contains('|') {
+                continue;
+            }
+            let mut listed: Vec<String> = comment.split('|').map(|s| s.trim().to_string()).collect();
+            listed.sort();
+            let mut want = names.clone();
+            want.sort();
+            assert_eq!(listed, want, "comment of `{line}`");
+            seen += 1;
+        }
+    }
+    assert_eq!(seen, 3, "mode, target and normal_law comments of the regime-map example");
+}
+
+#[test]
+fn thornton_restitution_of_wall_and_pair_impacts() {
+    // Closed-form Thornton (1997) e(V), σ_y = 1 MPa, full formula, 20 µm ice grains (R = 10 µm), computed
+    // independently of the code (see dem::restitution_models tests): on the ABS wall V_y = 1.43300e-4 m/s,
+    // e(0.5) = 0.154177, e(5) = 0.086703; on an equal free ice grain (R* = 5 µm, m* = m/2,
+    // E* = 5.42095e9 Pa) Eq. 31 gives e(0.5) = 0.076426, e(5) = 0.042977, the thesis's wall formula
+    // e(0.5) = 0.090877, e(5) = 0.051104. The run's e is set from its normal impact speed (tolerance 2e-6,
+    // the 6 printed digits) and realised by the Hertz impact to 2e-3 (200 steps per contact).
+    use spatter_dem::restitution_models::{ThorntonForm, YieldGeometry};
+    let cases = [
+        (TargetKind::Wall, YieldGeometry::Wall, [0.154177, 0.086703]),
+        (TargetKind::Particle, YieldGeometry::Pair, [0.076426, 0.042977]),
+        (TargetKind::Particle, YieldGeometry::Wall, [0.090877, 0.051104]),
+    ];
+    for (target, geometry, es) in cases {
+        let mut cfg = SnowConfig { target, ..Default::default() };
+        cfg.contact.normal_law = super::config::NormalLawKind::Hertz;
+        cfg.contact.work_of_adhesion_j_m2 = 0.0;
+        cfg.contact.restitution = RestitutionModel::Thornton {
+            yield_stress_pa: 1e6,
+            form: ThorntonForm::Full,
+            yield_geometry: geometry,
+        };
+        let model = model_of(&cfg);
+        for (v, e) in [0.5, 5.0].into_iter().zip(es) {
+            let (r, setup) = model.simulate(20e-6, v, 0.0, [0.0, 0.0], Surface::Configured);
+            assert!(
+                (setup.restitution_input - e).abs() < 2e-6,
+                "{target:?} {geometry:?} V = {v}: {}",
+                setup.restitution_input
+            );
+            assert_eq!(r.outcome, Outcome::Bounce);
+            assert!(
+                (r.restitution - e).abs() < 2e-3,
+                "{target:?} {geometry:?} V = {v}: realised {}",
+                r.restitution
+            );
+        }
+    }
+}
+
+#[test]
+fn sample_impacts_write_the_target_they_hit() {
+    // The geometry beside the sample traces must be the target of the run: the plane patch for the wall,
+    // the sphere surface (radius = partner radius, closed: enclosed volume (4/3)πr³ within 1 %, the UV
+    // tessellation's deficit at 24 × 48 is 0.6 %) for a wall sphere or partner particle, the bed spheres
+    // as points with radius_m for a rough wall.
+    use super::samples::write_sample_impacts;
+    use spatter_core::mesh::TriMesh;
+    use spatter_core::Vec3;
+    let root = tempfile::tempdir().unwrap();
+    for (target, partner, file) in [
+        (TargetKind::Wall, None, "wall.vtu"),
+        (TargetKind::WallSphere, Some(2e-6), "target_sphere.vtu"),
+        (TargetKind::Particle, None, "target_sphere.vtu"),
+    ] {
+        let dir = RunDir::create(&root.path().join(format!("{target:?}"))).unwrap();
+        let cfg = SnowConfig { target, partner_diameter_m: partner, ..Default::default() };
+        let model = model_of(&cfg);
+        let arts = write_sample_impacts(&model, Surface::Configured, &[(10e-6, 0.5, "a")], &dir).unwrap();
+        let path = dir.root().join("samples").join(file);
+        assert!(arts.iter().any(|(_, p)| *p == path), "{target:?}: {arts:?}");
+        let other = if file == "wall.vtu" { "target_sphere.vtu" } else { "wall.vtu" };
+        assert!(!dir.root().join("samples").join(other).exists(), "{target:?}: no {other}");
+        let data = spatter_io::vtu::read(&path).unwrap();
+        match target {
+            TargetKind::Wall => assert!(data.points.iter().all(|p| p.z == 0.0)),
+            _ => {
+                let radius = partner.unwrap_or(10e-6) / 2.0;
+                assert!(data.points.iter().all(|p| (p.length() / radius - 1.0).abs() < 1e-12), "{target:?}");
+                let tris: Vec<[u32; 3]> =
+                    data.connectivity.chunks(3).map(|c| [c[0] as u32, c[1] as u32, c[2] as u32]).collect();
+                let mesh = TriMesh { vertices: data.points.clone(), triangles: tris };
+                let v = mesh.signed_volume();
+                let exact = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+                assert!((v / exact - 1.0).abs() < 1e-2 && v < exact, "{target:?}: volume {v} vs {exact}");
+                assert!(mesh.topology().edge_use_count.iter().all(|&n| n == 2), "closed surface");
+            }
+        }
+    }
+    // Rough wall: the bed spheres.
+    let cfg = small(Mode::RoughWall);
+    let bed = super::runner::make_bed(&cfg);
+    let index = super::bed_index::BedIndex::new(&bed.spheres);
+    let dir = RunDir::create(&root.path().join("bed")).unwrap();
+    write_sample_impacts(&model_of(&cfg), Surface::bed(&bed, &index), &[(10e-6, 0.5, "a")], &dir).unwrap();
+    let data = spatter_io::vtu::read(&dir.root().join("samples/bed.vtu")).unwrap();
+    assert_eq!(data.points.len(), bed.spheres.len());
+    assert_eq!(data.points[3], Vec3::from(bed.spheres[3].centre));
+    assert!(data.point_data["radius_m"].1.iter().all(|&r| r == 0.5e-6));
 }
