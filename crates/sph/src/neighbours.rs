@@ -201,6 +201,22 @@ impl NeighbourGrid {
         }
         let gap = |c: f64, k: usize| (k as f64 - c).max(c - (k + 1) as f64).max(0.0);
         let r2 = r * r;
+        // Cells are at least half the support (the grid only ever enlarges them), so a query reaches
+        // at most two cells beyond its own along each axis.
+        debug_assert!(r <= 2.0 + 1e-9, "query reach {r} cells");
+        // Along x, cell cx ± k (k = 1, 2) of a row is needed when its squared gap to p is within the
+        // row's remaining squared radius: squared gaps computed once per query, compared per row (no
+        // square root or rounding per row).
+        let cx = floor(q.x);
+        let fx = q.x - cx;
+        let (gl1, gl2, gr1, gr2) =
+            (fx * fx, (fx + 1.0) * (fx + 1.0), (1.0 - fx) * (1.0 - fx), (2.0 - fx) * (2.0 - fx));
+        let cx = cx as i64;
+        let mut gy2 = [0.0f64; 6];
+        for (g, y) in gy2.iter_mut().zip(y0..=y1) {
+            let d = gap(q.y, y);
+            *g = d * d;
+        }
         for z in z0..=z1 {
             let dz = gap(q.z, z);
             let rz2 = r2 - dz * dz;
@@ -208,19 +224,17 @@ impl NeighbourGrid {
                 continue;
             }
             let y_from = if after && z == oz { y0.max(oy) } else { y0 };
-            for y in y_from..=y1 {
-                let dy = gap(q.y, y);
-                let rem = rz2 - dy * dy;
+            for y in y_from..=y1.min(y0 + 5) {
+                let rem = rz2 - gy2[y - y0];
                 if rem < 0.0 {
                     continue;
                 }
-                let w = rem.sqrt();
-                let lo = floor(q.x - w);
-                let hi = floor(q.x + w);
-                if hi < 0.0 || lo > (nx - 1) as f64 {
+                let lo = cx - (gl1 <= rem) as i64 - (gl2 <= rem) as i64;
+                let hi = cx + (gr1 <= rem) as i64 + (gr2 <= rem) as i64;
+                if hi < 0 || lo > (nx - 1) as i64 {
                     continue;
                 }
-                let x0 = lo.max(0.0) as usize;
+                let x0 = lo.max(0) as usize;
                 let x1 = (hi as usize).min(nx - 1);
                 let row = (z * ny + y) * nx;
                 let start = self.cells.cell_range(row + x0).start;

@@ -136,6 +136,7 @@ pub(crate) struct Consts {
     pub m: f64,
     pub h: f64,
     pub support: f64,
+    /// Squared pair cut-off: (2h)² less 10⁻⁴ of it (see `Simulation::consts`).
     pub r2max: f64,
     pub rho0: f64,
     /// ½ α c₀: Π_ij = −α c₀ μ_ij / ρ̄_ij with 1/ρ̄_ij = ½ (1/ρ_i + 1/ρ_j).
