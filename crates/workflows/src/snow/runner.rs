@@ -251,14 +251,16 @@ pub fn contact_reports(cfg: &SnowConfig) -> Vec<ContactReport> {
 /// Effective contact quantities, Tabor parameter and time-step estimates at the smallest and largest
 /// diameter (printed for every run).
 pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
-    let target = match cfg.mode {
-        Mode::RoughWall => "rough-wall bed sphere".to_string(),
-        _ => format!("{:?}", cfg.target),
+    let target = match (cfg.mode, cfg.target) {
+        (Mode::RoughWall, _) => "a rough-wall bed sphere",
+        (_, super::config::TargetKind::Wall) => "the flat wall",
+        (_, super::config::TargetKind::WallSphere) => "a frozen wall sphere",
+        (_, super::config::TargetKind::Particle) => "a free partner particle",
     };
     let mut out = Vec::new();
     for c in contact_reports(cfg) {
         out.push(format!(
-            "contact at d = {:.3e} m with the {target}: E* = {:.5e} Pa, R* = {:.5e} m, m* = {:.5e} kg; Tabor parameter (z0 = 0.4 / 0.2 nm) {:.3} / {:.3} (JKR valid above 5)",
+            "contact at d = {:.3e} m with {target}: E* = {:.5e} Pa, R* = {:.5e} m, m* = {:.5e} kg; Tabor parameter (z0 = 0.4 / 0.2 nm) {:.3} / {:.3} (JKR valid above 5)",
             c.diameter, c.e_star, c.r_star, c.m_star, c.tabor.0, c.tabor.1
         ));
         out.push(format!(
