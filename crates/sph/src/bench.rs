@@ -4,7 +4,9 @@
 //! Printed: particle-steps per second (fluid particles × steps / wall time), particle-interactions per
 //! second (directed fluid–fluid pairs within the kernel support, counted once per particle that receives
 //! the interaction, plus fluid–wall pairs, per wall second), the parallel efficiency, and the bytes held
-//! per fluid particle by the state and every scratch buffer (walls included).
+//! per fluid particle by the state and every scratch buffer (walls included). Also the CPU time per step
+//! and the interactions per CPU-second ([`cpu_seconds`]): on a machine shared with other work the CPU
+//! time measures the work, while the wall time and the parallel efficiency need an idle machine.
 
 use crate::kernel::Dim;
 use crate::params::SphParams;
@@ -152,8 +154,9 @@ pub fn bench(quick: bool) -> Result<Vec<String>, crate::SphError> {
     );
     if let (Some(c1), Some(c2)) = (r1.cpu_seconds, r2.cpu_seconds) {
         if c2 > 0.0 {
-            // Work efficiency: 1-thread CPU time over 2-thread CPU time for the same steps. Below 100 %
-            // only when the parallel scheme adds work; it says nothing about waiting for a busy core.
+            // 1-thread CPU time over 2-thread CPU time for the same steps: below 100 % when the parallel
+            // scheme adds work or a thread spins while it waits for the other (rayon idles by spinning
+            // briefly); it says nothing about waiting for a core that another process holds.
             eff.push_str(&format!("; CPU-time ratio 1/2 threads: {:.1} %", 100.0 * c1 / c2));
         }
     }
