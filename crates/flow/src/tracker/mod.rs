@@ -270,19 +270,22 @@ impl<F: FlowField> Tracker<F> {
     /// step loop then ends at the last airborne parcel.
     pub fn sort_parcels(&mut self) {
         let ps = &self.state.parcels;
-        let mut order: Vec<u32> = (0..ps.len() as u32).collect();
-        order.sort_unstable_by_key(|&i| {
-            let p = &ps[i as usize];
-            (p.status != Status::Airborne, p.hint, p.id)
-        });
-        self.state.parcels = order.iter().map(|&i| ps[i as usize].clone()).collect();
+        // Keys are unique (ids are), so the parallel unstable sort gives one order for any thread count.
+        let mut keys: Vec<(bool, u32, u64, u32)> = ps
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| (p.status != Status::Airborne, p.hint, p.id, i as u32))
+            .collect();
+        keys.par_sort_unstable();
+        let order = keys;
+        self.state.parcels = order.par_iter().map(|k| ps[k.3 as usize].clone()).collect();
         if !self.state.histories.is_empty() {
             let h = &self.state.histories;
-            self.state.histories = order.iter().map(|&i| h[i as usize].clone()).collect();
+            self.state.histories = order.par_iter().map(|k| h[k.3 as usize].clone()).collect();
         }
         if !self.state.extras.is_empty() {
             let e = &self.state.extras;
-            self.state.extras = order.iter().map(|&i| e[i as usize].clone()).collect();
+            self.state.extras = order.par_iter().map(|k| e[k.3 as usize].clone()).collect();
         }
         self.state.live_end = self.state.parcels.iter().take_while(|p| p.status == Status::Airborne).count();
     }
