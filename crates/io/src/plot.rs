@@ -73,6 +73,16 @@ pub fn tick_label(v: f64) -> String {
     }
 }
 
+/// The tick label of `v` on a linear axis spanning `span` (0 for a log axis): a value within 1e-9 of the
+/// span from zero is rounding noise of a zero and is printed as `0` (an axis whose data start at a
+/// computed 2.7e-20 instead of 0 would otherwise label its first tick `2.711e-20`).
+pub fn axis_tick_label(v: f64, span: f64) -> String {
+    if v.abs() <= 1e-9 * span.abs() {
+        return "0".into();
+    }
+    tick_label(v)
+}
+
 /// Colours assigned to series without an explicit colour (colour-blind friendly, Okabe–Ito).
 const PALETTE: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
@@ -223,6 +233,9 @@ impl Chart {
         Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
     {
         let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let ((x0, x1), (y0, y1)) = self.bounds();
+        let (x_span, y_span) =
+            (if self.log_x { 0.0 } else { x1 - x0 }, if self.log_y { 0.0 } else { y1 - y0 });
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, ("sans-serif", 22))
             .margin(14)
@@ -236,8 +249,8 @@ impl Chart {
             .y_desc(&self.y_label)
             .x_labels(8)
             .y_labels(8)
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
+            .x_label_formatter(&|v| axis_tick_label(*v, x_span))
+            .y_label_formatter(&|v| axis_tick_label(*v, y_span))
             .label_style(("sans-serif", 14))
             .axis_desc_style(("sans-serif", 16))
             .light_line_style(RGBColor(235, 235, 235))
@@ -462,6 +475,10 @@ mod tests {
         assert_eq!(tick_label(0.25), "0.25");
         assert_eq!(tick_label(1200.0), "1200");
         assert_eq!(tick_label(2.5e7), "2.5e7");
+        // Rounding noise of a zero on a linear axis reads 0; on a log axis (span 0) tiny values stay.
+        assert_eq!(axis_tick_label(2.711e-20, 1.4e-3), "0");
+        assert_eq!(axis_tick_label(2e-4, 1.4e-3), "2e-4");
+        assert_eq!(axis_tick_label(2.711e-20, 0.0), "2.711e-20");
     }
 
     #[test]
