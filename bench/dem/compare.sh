@@ -32,17 +32,21 @@ if [ "${METHOD:-}" = "chunks" ]; then
     ly="$(awk '/^box_y/ {print $2}' <<<"$out")"
     n="$(awk '/^particles/ {print $2}' <<<"$out")"
     spatter1="$(awk '/best_chunk/ {print $2}' <<<"$out")"
-    # The same without per-contact energy bookkeeping (LAMMPS books none).
+    # The same with per-contact energy bookkeeping, and without any (LAMMPS books none).
+    outp="$("$bin" $quick --lammps-data "$work/boxp.data" --chunks "$chunks" --chunk-steps 1 --per-contact)"
+    spatterp="$(awk '/best_chunk/ {print $2}' <<<"$outp")"
     out0="$("$bin" $quick --lammps-data "$work/box0.data" --chunks "$chunks" --chunk-steps 1 --no-energy)"
     spatter0="$(awk '/best_chunk/ {print $2}' <<<"$out0")"
     (cd "$work" && lmp -in "$here/in.box_chunks" -var data "$work/box.data" -var lx "$lx" -var ly "$ly" \
         -var chunk 1 -var chunks "$chunks" -log "$work/log.lammps" -screen none)
     lammps="$(grep '^Loop time' "$work/log.lammps" | awk -v n="$n" '{print n * $9 / $4}' | sort -g | tail -1)"
     printf 'LAMMPS   1 thread, fastest step: %.4e particle-steps/s\n' "$lammps"
-    printf 'spatter  1 thread, fastest step: %.4e particle-steps/s (energy budget on, the default)\n' "$spatter1"
+    printf 'spatter  1 thread, fastest step: %.4e particle-steps/s (energy budget, residual method: the default)\n' "$spatter1"
+    printf 'spatter  1 thread, fastest step: %.4e particle-steps/s (engine.energy_method = "per_contact")\n' "$spatterp"
     printf 'spatter  1 thread, fastest step: %.4e particle-steps/s (engine.track_energy = false)\n' "$spatter0"
-    printf 'ratio spatter/LAMMPS (1 thread): %.2f with the energy budget, %.2f without\n' \
+    printf 'ratio spatter/LAMMPS (1 thread): %.2f with the energy budget (default), %.2f per contact, %.2f without\n' \
         "$(awk -v a="$spatter1" -v b="$lammps" 'BEGIN {print a / b}')" \
+        "$(awk -v a="$spatterp" -v b="$lammps" 'BEGIN {print a / b}')" \
         "$(awk -v a="$spatter0" -v b="$lammps" 'BEGIN {print a / b}')"
     exit 0
 fi
@@ -52,6 +56,9 @@ lx="$(awk '/^box_x/ {print $2}' <<<"$out")"
 ly="$(awk '/^box_y/ {print $2}' <<<"$out")"
 spatter1="$(awk '/^spatter_threads_1/ {print $2}' <<<"$out")"
 spatter2="$(awk '/^spatter_threads_2/ {print $2}' <<<"$out")"
+outp="$("$CARGO_TARGET_DIR/release/examples/dem_bench" $quick --lammps-data "$work/boxp.data" --steps "$steps" \
+    --threads-only 1 --per-contact)"
+spatterp="$(awk '/^spatter_threads_1/ {print $2}' <<<"$outp")"
 out0="$("$CARGO_TARGET_DIR/release/examples/dem_bench" $quick --lammps-data "$work/box0.data" --steps "$steps" \
     --threads-only 1 --no-energy)"
 spatter0="$(awk '/^spatter_threads_1/ {print $2}' <<<"$out0")"
@@ -66,7 +73,9 @@ printf 'LAMMPS   1 thread : %.4e particle-steps/s\n' "$lammps"
 printf 'spatter  1 thread : %.4e particle-steps/s\n' "$spatter1"
 printf 'spatter  2 threads: %.4e particle-steps/s (parallel efficiency %.0f %%)\n' "$spatter2" \
     "$(awk -v a="$spatter1" -v b="$spatter2" 'BEGIN {print 50 * b / a}')"
+printf 'spatter  1 thread : %.4e particle-steps/s with per-contact energy bookkeeping\n' "$spatterp"
 printf 'spatter  1 thread : %.4e particle-steps/s without energy bookkeeping\n' "$spatter0"
-printf 'ratio spatter/LAMMPS (1 thread): %.2f with the energy budget, %.2f without\n' \
+printf 'ratio spatter/LAMMPS (1 thread): %.2f with the energy budget (residual, default), %.2f per contact, %.2f without\n' \
     "$(awk -v a="$spatter1" -v b="$lammps" 'BEGIN {print a / b}')" \
+    "$(awk -v a="$spatterp" -v b="$lammps" 'BEGIN {print a / b}')" \
     "$(awk -v a="$spatter0" -v b="$lammps" 'BEGIN {print a / b}')"

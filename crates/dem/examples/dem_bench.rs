@@ -1,7 +1,7 @@
 //! The DEM benchmark outside the CLI, with the LAMMPS data file export used by `bench/dem/compare.sh`:
 //!
 //! `cargo run --release -p spatter-dem --example dem_bench -- [--quick] [--lammps-data box.data]
-//!  [--steps N] [--threads-only 1]`
+//!  [--steps N] [--threads-only 1] [--per-contact | --no-energy]`
 
 use spatter_dem::bench::{dense_box, settle, time_run, write_lammps_data, BoxCase};
 
@@ -9,7 +9,14 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let flag = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let quick = args.iter().any(|a| a == "--quick");
-    let energy = !args.iter().any(|a| a == "--no-energy");
+    // Energy budget: residual (the scene default), `--per-contact`, or none (`--no-energy`).
+    let energy = if args.iter().any(|a| a == "--no-energy") {
+        None
+    } else if args.iter().any(|a| a == "--per-contact") {
+        Some(spatter_dem::EnergyMethod::PerContact)
+    } else {
+        Some(spatter_dem::EnergyMethod::Residual)
+    };
     if let Some(path) = flag("--lammps-data") {
         // Settle, export for LAMMPS, and time the same state here.
         let case = if quick { BoxCase::quick() } else { BoxCase::full() };
@@ -39,7 +46,8 @@ fn main() {
             let t: usize = flag("--threads-only").map(|s| s.parse().expect("--threads-only N")).unwrap_or(1);
             let mut run = dense_box(&case);
             run.restore(state).expect("restore");
-            run.law.energy = energy;
+            run.law.energy = energy.is_some();
+            run.energy_method = energy.unwrap_or_default();
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().expect("pool");
             let mut best = f64::INFINITY;
             pool.install(|| {

@@ -19,5 +19,5 @@ pub mod walls;
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};
 pub use scene::{run, SceneConfig};
-pub use sim::{EnergyReport, Integrator, Settings, Simulation};
+pub use sim::{EnergyMethod, EnergyReport, Integrator, Settings, Simulation};
 pub use validation::validation_cases;

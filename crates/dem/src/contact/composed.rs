@@ -70,6 +70,10 @@ where
         }
     }
 
+    fn without_energy(&self) -> Self {
+        Composed { energy: false, ..self.clone() }
+    }
+
     #[inline(always)]
     fn range(&self, p: &Self::Params, r_eff: f64) -> f64 {
         self.normal.range(&p.normal, r_eff)

@@ -159,6 +159,13 @@ pub trait ContactLaw: Clone + Send + Sync + 'static {
     /// Force and torque of one contact in this step; updates `state`. Returns `None` when the partners do
     /// not interact (the engine then resets `state` to `Default`).
     fn compute(&self, p: &Self::Params, c: &ContactInput, state: &mut Self::State) -> Option<ContactOutput>;
+
+    /// The same law without energy bookkeeping ([`ContactOutput::energy`] and
+    /// [`ContactOutput::dissipated`] may then be zero). Must not change forces or states: the engine uses
+    /// it in steps that need no energies. The default keeps the law as it is.
+    fn without_energy(&self) -> Self {
+        self.clone()
+    }
 }
 
 /// The standard combination: Hertz normal, restitution damping, Mindlin tangential with history, no

@@ -164,6 +164,7 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
         },
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
+    sim.energy_method = if e.track_energy { e.energy_method } else { crate::sim::EnergyMethod::PerContact };
     sim.gravity = cfg.gravity_m_s2;
     for w in built.walls {
         sim.add_wall(w);
@@ -275,6 +276,9 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
             if step % inject_every[k] == 0 {
                 inject(&mut sim, inj, region);
             }
+        }
+        if (step + 1) % out_every == 0 || step + 1 == total_steps {
+            sim.request_energy();
         }
         sim.step()?;
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {

@@ -128,7 +128,15 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
 
-        let law = &self.law;
+        // Without energies wanted in this step the law skips its bookkeeping (forces are identical).
+        let booking = self.booking_energy();
+        let quiet;
+        let law = if booking {
+            &self.law
+        } else {
+            quiet = self.law.without_energy();
+            &quiet
+        };
         let params = &self.params;
         let walls = &self.walls;
         let kin = &self.scratch.kin;
@@ -454,6 +462,7 @@ impl<L: ContactLaw> Simulation<L> {
             pair_contacts: acc.pair_contacts,
             wall_contacts: acc.wall_contacts,
             max_overlap_ratio: acc.max_ratio,
+            energy_booked: booking,
         };
         self.last_worst = acc.worst;
     }

@@ -59,11 +59,32 @@ impl Default for Settings {
     }
 }
 
+/// How the energy budget's elastic and dissipated terms are obtained (see docs/dem.md, "Energy budget").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergyMethod {
+    /// Every contact books its stored and dissipated energy in every step (the contact law's `energy`
+    /// flag must be on): the dissipation is the exact sum of dashpot, slip and rolling work.
+    #[default]
+    PerContact,
+    /// Contacts book nothing in ordinary steps. The elastic energy is booked only in steps requested with
+    /// [`Simulation::request_energy`]; the dissipated energy is the residual
+    /// E_in + W_external + W_walls − E_mech(t), where E_in is the kinetic and potential energy the
+    /// particles brought in (minus what removed particles took out). The residual also contains the
+    /// integrator's own energy error (O(Δt²), either sign).
+    Residual,
+}
+
 /// Energy accounts integrated over the run \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyAccounts {
-    /// Work dissipated by dashpots, Coulomb slip and rolling resistance.
+    /// Work dissipated by dashpots, Coulomb slip and rolling resistance (per-contact bookkeeping only).
     pub dissipated: f64,
+    /// Kinetic + rotational energy of the particles at insertion, minus that of removed particles.
+    pub injected_kinetic: f64,
+    /// Σ m x of the free particles at insertion, minus that of removed particles \[kg m\]; their
+    /// potential energy is −g·(Σ m x).
+    pub injected_moment: Vec3,
     /// Work done on the particles by external forces (including the external-force hook).
     pub external_work: f64,
     /// Work done on the particles by moving walls.
@@ -81,6 +102,8 @@ pub struct LastEvaluation {
     pub wall_contacts: u64,
     /// Largest overlap divided by the smaller radius.
     pub max_overlap_ratio: f64,
+    /// The contacts booked their energies in this evaluation (`elastic` is meaningful).
+    pub energy_booked: bool,
 }
 
 /// The energy budget at one instant.
@@ -138,6 +161,8 @@ pub struct DynState<S> {
     pub wall_list: WallList<S>,
     /// Largest particle radius seen \[m\].
     pub r_max: f64,
+    /// Book energies in the evaluations of the next step (residual method).
+    pub energy_requested: bool,
 }
 
 impl<S> Default for DynState<S> {
@@ -156,6 +181,7 @@ impl<S> Default for DynState<S> {
             list: PairList::default(),
             wall_list: WallList::default(),
             r_max: 0.0,
+            energy_requested: false,
         }
     }
 }
@@ -219,6 +245,8 @@ pub struct Simulation<L: ContactLaw> {
     /// Time step \[s\].
     pub dt: f64,
     pub settings: Settings,
+    /// How the energy budget is obtained (default: per contact).
+    pub energy_method: EnergyMethod,
     pub(crate) st: DynState<L::State>,
     scratch: Scratch,
     external: Option<Box<dyn ExternalForces>>,
@@ -228,6 +256,8 @@ pub struct Simulation<L: ContactLaw> {
     base_forces_ready: bool,
     /// A kick met a non-finite velocity, angular velocity or position.
     state_maybe_nonfinite: bool,
+    /// The velocities are half-step velocities v(t − Δt/2) (between the kicks of velocity Verlet).
+    pub(crate) half_step_velocities: bool,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -252,12 +282,14 @@ impl<L: ContactLaw> Simulation<L> {
             gravity: Vec3::ZERO,
             dt,
             settings,
+            energy_method: EnergyMethod::PerContact,
             st: DynState::default(),
             scratch: Scratch::default(),
             external: None,
             last_worst: (0, 0),
             base_forces_ready: false,
             state_maybe_nonfinite: false,
+            half_step_velocities: false,
         }
     }
 
@@ -314,7 +346,13 @@ impl<L: ContactLaw> Simulation<L> {
         let id = self.particles.push(p, rho);
         let i = self.particles.len() - 1;
         if !p.frozen {
-            self.particles.force[i] = self.particles.mass(i) * self.gravity;
+            let m = self.particles.mass(i);
+            self.particles.force[i] = m * self.gravity;
+            let pa = &self.particles;
+            let e = &mut self.st.energy;
+            e.injected_kinetic +=
+                0.5 * m * pa.vel[i].length_squared() + 0.5 * pa.inertia(i) * pa.omega[i].length_squared();
+            e.injected_moment += m * pa.pos[i];
         }
         id
     }
@@ -378,6 +416,17 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.forces_valid = false;
     }
 
+    /// Asks the next step to book the contacts' elastic energy (needed before [`Simulation::energy`] under
+    /// [`EnergyMethod::Residual`]; a no-op cost-wise under per-contact bookkeeping).
+    pub fn request_energy(&mut self) {
+        self.st.energy_requested = true;
+    }
+
+    /// Whether contacts book their energies in the evaluations of the current step.
+    pub(crate) fn booking_energy(&self) -> bool {
+        self.energy_method == EnergyMethod::PerContact || self.st.energy_requested
+    }
+
     /// Marks the neighbour lists as stale (after editing particles directly).
     pub fn invalidate(&mut self) {
         self.st.needs_rebuild = true;
@@ -429,7 +478,9 @@ impl<L: ContactLaw> Simulation<L> {
                 }
                 let vmax = self.kick_drift(0.5, true, true);
                 self.advance_time(vmax);
+                self.half_step_velocities = true;
                 self.maybe_rebuild();
+                self.half_step_velocities = false;
                 self.evaluate()?;
                 self.kick_drift(0.5, false, false);
             }
@@ -446,6 +497,7 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         self.st.step += 1;
+        self.st.energy_requested = false;
         self.check_finite()
     }
 
@@ -490,7 +542,9 @@ impl<L: ContactLaw> Simulation<L> {
         Ok(())
     }
 
-    /// The energy budget now (kinetic energies use the current, full-step velocities).
+    /// The energy budget now (kinetic energies use the current, full-step velocities). Under
+    /// [`EnergyMethod::Residual`] call [`Simulation::request_energy`] before the last step, or the elastic
+    /// energy of that step is unknown (reported as 0, and the dissipation absorbs it).
     pub fn energy(&self) -> EnergyReport {
         let p = &self.particles;
         let mut ke = 0.0;
@@ -505,13 +559,22 @@ impl<L: ContactLaw> Simulation<L> {
             rot += 0.5 * p.inertia(i) * p.omega[i].length_squared();
             pot -= m * self.gravity.dot(p.pos[i]);
         }
+        let a = &self.st.energy;
+        let elastic = self.st.last.elastic;
+        let dissipated = match self.energy_method {
+            EnergyMethod::PerContact => a.dissipated,
+            EnergyMethod::Residual => {
+                let e_in = a.injected_kinetic - self.gravity.dot(a.injected_moment);
+                e_in + a.external_work + a.wall_work - (ke + rot + pot + elastic)
+            }
+        };
         EnergyReport {
             time: self.st.time,
             kinetic: ke,
             rotational: rot,
-            elastic: self.st.last.elastic,
+            elastic,
             potential: pot,
-            dissipated: self.st.energy.dissipated,
+            dissipated,
             external_work: self.st.energy.external_work,
             wall_work: self.st.energy.wall_work,
             pair_contacts: self.st.last.pair_contacts,

@@ -102,6 +102,21 @@ impl<L: ContactLaw> Simulation<L> {
         if let Some(dom) = self.settings.domain {
             let n0 = self.particles.len();
             let pos = self.particles.pos.clone();
+            // The energy the removed particles take out of the budget. Between the kicks of velocity Verlet
+            // the velocities belong to the half step, so the potential energy is taken at the matching
+            // position x − ½Δt v: then a particle in free flight leaves with its energy at the end of the
+            // last step up to m g²Δt²/8.
+            let p = &self.particles;
+            let e = &mut self.st.energy;
+            let back = if self.half_step_velocities { 0.5 * self.dt } else { 0.0 };
+            for (i, &x) in pos.iter().enumerate() {
+                if p.inv_mass[i] > 0.0 && !dom.contains(x) {
+                    let m = p.mass(i);
+                    e.injected_kinetic -= 0.5 * m * p.vel[i].length_squared()
+                        + 0.5 * p.inertia(i) * p.omega[i].length_squared();
+                    e.injected_moment -= m * (x - back * p.vel[i]);
+                }
+            }
             self.particles.retain(|i| dom.contains(pos[i]));
             self.st.removed += (n0 - self.particles.len()) as u64;
         }
