@@ -232,6 +232,8 @@ pub struct SpeedDependentParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SpeedDependentState {
     pub c_n: f64,
+    /// The contact has formed and `c_n` is set (the engine resets the state when the contact ends).
+    pub formed: bool,
 }
 
 impl crate::contact::DampingLaw for SpeedDependentDamping {
@@ -248,12 +250,17 @@ impl crate::contact::DampingLaw for SpeedDependentDamping {
         }
     }
 
-    fn on_formed(
+    #[inline]
+    fn in_contact(
         &self,
         p: &SpeedDependentParams,
         c: &crate::contact::ContactInput,
         s: &mut SpeedDependentState,
     ) {
+        if s.formed {
+            return;
+        }
+        s.formed = true;
         let v = (-c.v_rel.dot(c.normal)).max(0.0);
         let props = ImpactProps { e_star: p.e_star, density: p.density, r_star: c.r_eff, m_star: c.m_eff };
         let e = self.model.restitution(v, &props);

@@ -39,11 +39,10 @@ pub struct ComposedParams<NP, DP, TP, RP> {
     pub rolling: RP,
 }
 
-/// Per-contact state of a [`Composed`] law.
+/// Per-contact state of a [`Composed`] law: the states of its parts and nothing else (with Hertz,
+/// restitution damping and Mindlin only the tangential history, 32 bytes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ComposedState<NS, DS, TS, RS> {
-    /// Set at first touch (the damping law's `on_formed` has run); cleared when the contact ends.
-    pub formed: bool,
     pub normal: NS,
     pub damping: DS,
     pub tangential: TS,
@@ -82,10 +81,7 @@ where
     #[inline(always)]
     fn compute(&self, p: &Self::Params, c: &ContactInput, s: &mut Self::State) -> Option<ContactOutput> {
         let nf = self.normal.evaluate(&p.normal, c, &mut s.normal)?;
-        if !s.formed {
-            s.formed = true;
-            self.damping.on_formed(&p.damping, c, &mut s.damping);
-        }
+        self.damping.in_contact(&p.damping, c, &mut s.damping);
         let n = c.normal;
         let vn = c.v_rel.dot(n);
         let gamma_n = self.damping.normal_coefficient(&p.damping, &s.damping, &nf, c);

@@ -16,9 +16,11 @@ pub trait DampingLaw: Clone + Debug + Send + Sync + 'static {
     /// Precomputes pair-type parameters; `normal_exponent` is [`super::NormalLaw::damping_exponent`].
     fn params(&self, pair_index: usize, props: &PairProps, normal_exponent: f64) -> Self::Params;
 
-    /// Called once when a contact forms, with the kinematics of that moment (impact normal speed is
-    /// −c.v_rel·c.normal).
-    fn on_formed(&self, _p: &Self::Params, _c: &ContactInput, _state: &mut Self::State) {}
+    /// Called in every evaluation of a contact, before the coefficients are asked for. A law that fixes
+    /// something at first touch (e.g. the impact speed, −c.v_rel·c.normal) keeps its own "formed" flag in
+    /// its state, so laws that need none store nothing per contact. The default does nothing.
+    #[inline(always)]
+    fn in_contact(&self, _p: &Self::Params, _c: &ContactInput, _state: &mut Self::State) {}
 
     /// Normal dashpot coefficient γ_n ≥ 0 \[N s/m\].
     fn normal_coefficient(

@@ -323,3 +323,33 @@ fn rescaled_history_follows_the_contact_radius_only_when_it_shrinks() {
         assert!((t.force.x + f).abs() < 1e-12 * f, "{k_prev:e} → {k:e}: {} vs {}", t.force.x, -f);
     }
 }
+
+#[test]
+fn the_standard_law_stores_only_its_tangential_history_per_contact() {
+    // Memory per contact is what the 400 B/particle budget is spent on (docs/dem.md §5): the
+    // Hertz–Mindlin state is the history vector and the previous stiffness, nothing else (no padding).
+    assert_eq!(std::mem::size_of::<<HertzMindlin as ContactLaw>::State>(), 32);
+}
+
+#[test]
+fn speed_dependent_damping_fixes_its_coefficient_at_first_touch_only() {
+    // The coefficient follows the impact speed of the first evaluation; later, slower evaluations of the
+    // same contact keep it (Thornton e(V) is a property of the impact, digest §2.5).
+    use crate::restitution_models::{RestitutionModel, SpeedDependentDamping, SpeedDependentState};
+    let law =
+        SpeedDependentDamping { model: RestitutionModel::default(), base: RestitutionDamping::default() };
+    let props = PairProps::new(&glass(), &rigid(0.3), 0.5, 0.0);
+    let p = <SpeedDependentDamping as DampingLaw>::params(&law, 0, &props, 1.5);
+    let fast = input(1e-6, Vec3::new(0.0, 0.0, -2.0), 1e-3, 1e-5, 1e-9);
+    let slow = input(1e-6, Vec3::new(0.0, 0.0, -0.1), 1e-3, 1e-5, 1e-9);
+    let mut s = SpeedDependentState::default();
+    law.in_contact(&p, &fast, &mut s);
+    let c_first = s.c_n;
+    assert!(s.formed && c_first > 0.0);
+    law.in_contact(&p, &slow, &mut s);
+    assert_eq!(s.c_n, c_first, "a formed contact keeps its coefficient");
+    // A contact that formed at the slow speed gets another coefficient (so the check above can fail).
+    let mut s_slow = SpeedDependentState::default();
+    law.in_contact(&p, &slow, &mut s_slow);
+    assert!((s_slow.c_n - c_first).abs() > 1e-3 * c_first, "{} vs {c_first}", s_slow.c_n);
+}
