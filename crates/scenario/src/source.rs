@@ -63,9 +63,13 @@ impl Source {
         (line, col)
     }
 
-    /// Folder holding the file (relative paths in the scenario are resolved against it).
+    /// Folder holding the file (relative paths in the scenario are resolved against it); `.` for a bare
+    /// file name such as `scenario.toml` (whose parent is the empty path).
     pub fn base_dir(&self) -> PathBuf {
-        self.path.parent().map(Path::to_owned).unwrap_or_default()
+        match self.path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+            _ => PathBuf::from("."),
+        }
     }
 
     /// Span of the value at dotted `key` path (`a.b[2].c`); if the key is absent (a default was used),
