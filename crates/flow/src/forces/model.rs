@@ -8,6 +8,7 @@
 //! collects every other force per unit mass (explicit over the step). [`ForceModel::evaluate`] returns
 //! (τ, a, M) and the fluid angular acceleration of the particle's spin.
 
+use super::wall_lift::WallLiftSettings;
 use super::{drag::DragLaw, history::BassetSettings, inertial, lift, lift::TorqueLaw, Fluid};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
@@ -47,6 +48,10 @@ pub struct ForceSwitches {
     /// ⌈window_tau_p · τ_p/Δt⌉ steps up to `max_window_steps` (see [`BassetSettings`]).
     #[serde(default)]
     pub basset: Option<BassetSettings>,
+    /// Wall-bounded lift (Table 3.1 with Zeng's distance factor) near the tracker's bodies; absent = off.
+    /// Evaluated by the tracker, which knows the wall distance, not by [`ForceModel::evaluate`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_lift: Option<WallLiftSettings>,
 }
 
 fn yes() -> bool {
@@ -70,6 +75,7 @@ impl Default for ForceSwitches {
             added_mass_coefficient: 0.0,
             pressure_gradient: false,
             basset: None,
+            wall_lift: None,
         }
     }
 }
@@ -81,6 +87,9 @@ impl Validate for ForceSwitches {
         c.in_range("added_mass_coefficient", self.added_mass_coefficient, 0.0, true, 10.0, true);
         if let Some(b) = &self.basset {
             c.item("basset", b);
+        }
+        if let Some(w) = &self.wall_lift {
+            c.item("wall_lift", w);
         }
     }
 }

@@ -15,7 +15,9 @@
 //! = 0.05 Re (β and λ converted back give Zeng's 0.01 Re and (Re/250)^(5/2)); we follow Zeng's
 //! 0.025 Re and offer the printed form as [`ZengAlpha::AsPrinted`].
 
+use super::{sphere_mass, Fluid};
 use serde::{Deserialize, Serialize};
+use spatter_core::check::{Checker, Validate};
 
 /// One row of Jasion Table 3.1: F⁺ = p (a⁺)^q.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -83,7 +85,7 @@ pub enum ZengAlpha {
 /// Zeng's wall-distance factor C_L/C_L,w for a particle whose centre is `y` above the wall, diameter
 /// `d`, at shear Reynolds number `re` = Re_p*. Equals 1 at contact (y = d/2); zero for y > 4d.
 pub fn zeng_factor(y: f64, d: f64, re: f64, alpha_form: ZengAlpha) -> f64 {
-    if y > 4.0 * d {
+    if y > WALL_LIFT_RANGE_DIAMETERS * d {
         return 0.0;
     }
     let delta = (y / d - 0.5).max(0.0);
@@ -114,6 +116,68 @@ pub fn wall_lift_force(
         Some(form) => f * zeng_factor(y, d, 2.0 * a_plus, form),
         None => f,
     }
+}
+
+/// Ratio of wall distance to diameter beyond which [`zeng_factor`] (and therefore the tracker's wall lift)
+/// is zero: Zeng et al.'s fit covers centre distances y ≤ 4d.
+pub const WALL_LIFT_RANGE_DIAMETERS: f64 = 4.0;
+
+/// The wall-bounded lift as a switchable term of the tracker (scenario key `[forces] wall_lift`).
+///
+/// Each step a parcel within [`WALL_LIFT_RANGE_DIAMETERS`] diameters of a body surface (centre to the
+/// closest surface point, distance y) gets the acceleration [`wall_lift_acceleration`] along the unit
+/// vector from that surface point to its centre (away from the wall). The friction velocity is
+/// `friction_velocity_m_s` when given, else u_* = √(τ_w/ρ_f) from the wall-shear estimate of the closest
+/// triangle (`tracker::walls::Body::estimate_wall_shear`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallLiftSettings {
+    /// Which row(s) of Table 3.1 (default: the regime choice, [`WallLiftLaw::Regimes`]).
+    #[serde(default = "default_law")]
+    pub law: WallLiftLaw,
+    /// The α of Zeng's distance factor (default: Zeng et al. 2009).
+    #[serde(default)]
+    pub zeng_alpha: ZengAlpha,
+    /// A fixed friction velocity u_* \[m/s\] for every wall; absent = from the wall-shear estimate.
+    #[serde(rename = "friction_velocity_m_s", default, skip_serializing_if = "Option::is_none")]
+    pub friction_velocity: Option<f64>,
+}
+
+fn default_law() -> WallLiftLaw {
+    WallLiftLaw::Regimes
+}
+
+impl Default for WallLiftSettings {
+    fn default() -> Self {
+        WallLiftSettings { law: default_law(), zeng_alpha: ZengAlpha::Zeng, friction_velocity: None }
+    }
+}
+
+impl Validate for WallLiftSettings {
+    fn validate(&self, c: &mut Checker) {
+        if let Some(u) = self.friction_velocity {
+            c.positive("friction_velocity_m_s", u);
+        }
+    }
+}
+
+/// Wall-bounded lift per unit particle mass \[m/s²\] on a sphere of diameter `d` and density `rho_p`
+/// whose centre is `y` from the wall, with friction velocity `u_star`: [`wall_lift_force`] with Zeng's
+/// factor divided by the particle mass. Positive = away from the wall; zero beyond y = 4d.
+#[inline]
+pub fn wall_lift_acceleration(
+    s: &WallLiftSettings,
+    fluid: &Fluid,
+    d: f64,
+    rho_p: f64,
+    y: f64,
+    u_star: f64,
+) -> f64 {
+    if y > WALL_LIFT_RANGE_DIAMETERS * d || u_star <= 0.0 {
+        return 0.0;
+    }
+    wall_lift_force(s.law, Some(s.zeng_alpha), d, y, u_star, fluid.density, fluid.nu())
+        / sphere_mass(d, rho_p)
 }
 
 /// Friction velocity u_* = √(τ_w/ρ_f) \[m/s\] (Jasion eq. 3.21).

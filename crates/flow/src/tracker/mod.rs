@@ -16,7 +16,11 @@
 //!
 //! **Walls.** The segment x → x(Δt) is tested against every body (BVH); at the first hit the body's
 //! rule applies (stick, bounce with restitution for the rest of the step, or escape), up to
-//! `max_bounces` times per step.
+//! `max_bounces` times per step. With the wall-bounded lift switched on ([`ForceSwitches::wall_lift`])
+//! the closest body surface point within 4 d of the parcel (BVH query) gives the wall distance and the
+//! direction of the lift, which joins the other forces of the step ([`wall_lift`]).
+//!
+//! [`ForceSwitches::wall_lift`]: crate::forces::model::ForceSwitches::wall_lift
 //!
 //! **Parallelism.** Parcels are processed in fixed chunks of [`CHUNK`] with rayon; each parcel depends
 //! only on its own state (its random stream is `seeded(seed, parcel id)`), impacts are collected per
@@ -33,7 +37,10 @@ use crate::field::tetmesh::NONE;
 use crate::field::FlowField;
 use crate::forces::history::{acceleration_number, basset_coefficient, odar_hamilton, History};
 use crate::forces::model::{FluidLocal, ForceModel};
-use crate::forces::sphere_mass;
+use crate::forces::wall_lift::{
+    friction_velocity, wall_lift_acceleration, WallLiftSettings, WALL_LIFT_RANGE_DIAMETERS,
+};
+use crate::forces::{sphere_mass, Fluid};
 use deposit::{Deposit, Impact, ImpactOutcome};
 use exact_sum::ExactSum;
 use inject::NewParcel;
@@ -443,6 +450,20 @@ fn first_hit(bodies: &[Body], a: Vec3, b: Vec3) -> Option<(f64, usize, u32)> {
     best
 }
 
+/// Wall-bounded lift per unit mass on a parcel at `x` (zero farther than 4 d from every body, where the
+/// BVH query ends at the root box of each body).
+#[inline]
+pub fn wall_lift(bodies: &[Body], s: &WallLiftSettings, fluid: &Fluid, x: Vec3, d: f64, rho_p: f64) -> Vec3 {
+    let Some(w) = walls::nearest_wall(bodies, x, WALL_LIFT_RANGE_DIAMETERS * d) else {
+        return Vec3::ZERO;
+    };
+    let u_star = match s.friction_velocity {
+        Some(u) => u,
+        None => friction_velocity(bodies[w.body].wall_shear[w.triangle as usize], fluid.density),
+    };
+    wall_lift_acceleration(s, fluid, d, rho_p, w.distance, u_star) * w.away
+}
+
 /// Advances one parcel by one step. Returns an error for a non-finite state.
 #[inline]
 fn advance<F: FlowField>(
@@ -475,6 +496,9 @@ fn advance<F: FlowField>(
     let f = model.evaluate(d, rho, p.vel, spin, &fl);
     let mut inertia = f.inertia;
     let mut a = f.accel;
+    if let Some(wl) = &model.switches.wall_lift {
+        a += wall_lift(ctx.bodies, wl, &model.fluid, p.pos, d, rho);
+    }
     if let (Some(h), Some(bs)) = (hist, model.switches.basset) {
         let w = u - p.vel;
         let kb0 = basset_coefficient(model.fluid.density, model.fluid.viscosity, rho, d);

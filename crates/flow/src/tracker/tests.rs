@@ -463,3 +463,153 @@ fn default_basset_settings_follow_the_analytic_rise() {
     let (ours, exact) = light_sphere_rise(truncated)[3];
     assert!(ours > 1.5 * exact, "truncation error not reproduced: {ours} vs {exact}");
 }
+
+/// Wall-bounded lift by hand from Jasion (2013) eq. 3.49–3.50 (digests/seed_003_brownout.md §2.6):
+/// F = p (a⁺)^q ρ ν² · f_Zeng, a⁺ = Re*/2, Re* = d u_*/ν, with the Table 3.1 regime choice (Leighton–Acrivos
+/// below Re* = 0.6, Mollinger et al. below 5, Hall above) and Zeng et al. (2009)'s factor
+/// f = exp(−½δ(Re/250)^{4/3}) [exp(αδ^β) − λ], δ = y/d − ½, α = −exp(−0.3 + 0.025 Re), β = 0.8 + 0.01 Re,
+/// λ = (1 − e^{−δ})(Re/250)^{5/2}. Written out independently of the library.
+fn wall_lift_by_hand(d: f64, y: f64, u_star: f64, rho: f64, nu: f64) -> f64 {
+    let re = d * u_star / nu;
+    let (p, q) = if re < 0.6 {
+        (9.22, 4.0)
+    } else if re < 5.0 {
+        (56.9, 1.87)
+    } else {
+        (20.9, 2.31)
+    };
+    let delta = y / d - 0.5;
+    let alpha = -(-0.3 + 0.025 * re).exp();
+    let beta = 0.8 + 0.01 * re;
+    let lambda = (1.0 - (-delta).exp()) * (re / 250.0).powf(2.5);
+    let zeng =
+        (-0.5 * delta * (re / 250.0).powf(4.0 / 3.0)).exp() * ((alpha * delta.powf(beta)).exp() - lambda);
+    p * (0.5 * re).powf(q) * rho * nu * nu * zeng
+}
+
+#[test]
+fn wall_lift_points_away_from_the_nearest_wall_with_the_closed_form_magnitude() {
+    use crate::forces::wall_lift::WallLiftSettings;
+    // Drag and gravity off, parcels at rest: one step gives v = a Δt and x = x₀ + ½ a Δt² exactly, with a
+    // the wall lift per unit mass by hand (tolerance 1e-12 relative). τ_w = 0.3 Pa in air (ρ = 1.2) gives
+    // u_* = 0.5 m/s; a 100 µm grain then has Re* = 3.33 (Mollinger row); centre y = 1.5 d (δ = 1).
+    let fluid = air();
+    let (d, rho_p, tau_w, dt) = (100e-6, 2650.0, 0.3, 1e-5);
+    let u_star = (tau_w / fluid.density).sqrt();
+    let y = 1.5 * d;
+    let mass = std::f64::consts::PI / 6.0 * rho_p * d * d * d;
+    let accel = wall_lift_by_hand(d, y, u_star, fluid.density, fluid.nu()) / mass;
+    assert!(accel > 1.0, "a strong lift for this check: {accel} m/s²");
+    // Above and below the plate (away = ±z), beyond its +x edge in its plane (closest point on the edge,
+    // away = +x), and 4.1 d above it (outside Zeng's range: no force at all).
+    let cases = [
+        (Vec3::new(0.1, 0.05, y), Vec3::Z),
+        (Vec3::new(0.1, 0.05, -y), -Vec3::Z),
+        (Vec3::new(0.5 + y, 0.2, 0.0), Vec3::X),
+        (Vec3::new(0.1, 0.05, 4.1 * d), Vec3::ZERO),
+    ];
+    // u_* from the body's wall-shear estimate, or fixed in the settings.
+    for fixed in [None, Some(u_star)] {
+        let sw = ForceSwitches {
+            drag_enabled: false,
+            gravity: Vec3::ZERO,
+            wall_lift: Some(WallLiftSettings { friction_velocity: fixed, ..Default::default() }),
+            ..Default::default()
+        };
+        let mut body = plate_body(WallRule::Trap);
+        if fixed.is_none() {
+            body.wall_shear.fill(tau_w);
+        }
+        let mut tr = Tracker::new(
+            uniform(Vec3::ZERO),
+            ForceModel::new(fluid, sw),
+            TrackSettings { dt, resort_interval: 0, ..Default::default() },
+            vec![body],
+        );
+        for (x, _) in cases {
+            tr.add(one(x, Vec3::ZERO, d, rho_p), 0);
+        }
+        tr.step().unwrap();
+        for (p, (x0, dir)) in tr.state.parcels.iter().zip(cases) {
+            let v = accel * dt * dir;
+            assert!((p.vel - v).length() <= 1e-12 * accel * dt, "{x0} ({fixed:?}): {} vs {v}", p.vel);
+            assert!((p.pos - (x0 + 0.5 * v * dt)).length() <= 1e-12 * (accel * dt * dt + x0.length()));
+            assert_eq!(p.status, Status::Airborne);
+        }
+        assert_eq!(tr.state.parcels[3].vel, Vec3::ZERO, "beyond 4 d: exactly nothing");
+    }
+}
+
+#[test]
+fn wall_lift_changes_near_wall_trajectories_only_when_switched_on() {
+    use crate::forces::wall_lift::WallLiftSettings;
+    use std::collections::HashMap;
+    // Planar stagnation-point flow u = a(x, 0, −z) onto the plate (trap rule), Stokes drag and gravity.
+    // The plate's wall shear is estimated from the flow (τ_w = μ a |x_c|/h per triangle). Near-wall
+    // grains start at rest 2 d above triangle centroids, far ones 0.3 m above the same points.
+    let fluid = air();
+    let (a, h, d, rho_p, dt) = (50.0, 1e-3, 100e-6, 2650.0, 1e-4);
+    let field = AnalyticSet {
+        parts: vec![AnalyticField::StagnationPoint {
+            strain_rate: a,
+            centre: Vec3::ZERO,
+            normal: Vec3::Z,
+            axisymmetric: false,
+        }],
+        turbulence: None,
+    };
+    let mut body = plate_body(WallRule::Trap);
+    body.estimate_wall_shear(fluid.viscosity, h, |p| field.sample(p, 0.0, &mut 0, false).map(|s| s.u));
+    let centroids: Vec<Vec3> = (0..body.mesh.triangles.len()).map(|t| body.mesh.centroid(t)).collect();
+    let run = |on: bool, steps: usize| {
+        let sw = ForceSwitches {
+            drag: DragLaw::Stokes,
+            wall_lift: on.then(WallLiftSettings::default),
+            ..Default::default()
+        };
+        let mut tr = Tracker::new(
+            field.clone(),
+            ForceModel::new(fluid, sw),
+            TrackSettings { dt, ..Default::default() },
+            vec![body.clone()],
+        );
+        for c in &centroids {
+            tr.add(one(*c + 2.0 * d * Vec3::Z, Vec3::ZERO, d, rho_p), 0);
+            tr.add(one(*c + 0.3 * Vec3::Z, Vec3::ZERO, d, rho_p), 0);
+        }
+        for _ in 0..steps {
+            tr.step().unwrap();
+        }
+        let by_id: HashMap<u64, Parcel> = tr.state.parcels.iter().map(|p| (p.id, p.clone())).collect();
+        by_id
+    };
+    // First step: with the same start the two runs differ only by the lift, so with Stokes drag
+    // (τ = τ_p) Δv_z = a_L τ_p (1 − e^{−Δt/τ_p}), a_L by hand with u_* = √(μ a |x_c|/(h ρ)) (1e-9 relative).
+    let tau_p = stokes_time(&fluid, d, rho_p);
+    let (off, on) = (run(false, 1), run(true, 1));
+    for (k, c) in centroids.iter().enumerate() {
+        let id = 2 * k as u64;
+        let u_star = (fluid.viscosity * a * c.x.abs() / (h * fluid.density)).sqrt();
+        let mass = std::f64::consts::PI / 6.0 * rho_p * d * d * d;
+        let a_l = wall_lift_by_hand(d, 2.0 * d, u_star, fluid.density, fluid.nu()) / mass;
+        let dv = on[&id].vel - off[&id].vel;
+        let expect = a_l * tau_p * -(-dt / tau_p).exp_m1();
+        assert!((dv.z - expect).abs() <= 1e-9 * expect, "triangle {k}: Δv_z {} vs {expect}", dv.z);
+        assert!(dv.x.abs() + dv.y.abs() <= 1e-12 * expect, "lift is along the wall normal: {dv}");
+    }
+    // Over 200 steps (0.02 s): far grains never come within 4 d of the plate and keep exactly the same
+    // path; near-wall grains are held off the plate where the shear is high, so fewer deposit.
+    let (off, on) = (run(false, 200), run(true, 200));
+    let mut deposited = [0, 0];
+    for id in 0..2 * centroids.len() as u64 {
+        let (p0, p1) = (&off[&id], &on[&id]);
+        if id % 2 == 1 {
+            assert_eq!((p0.pos, p0.vel, p0.status), (p1.pos, p1.vel, p1.status), "far parcel {id}");
+        } else {
+            deposited[0] += (p0.status == Status::Deposited) as usize;
+            deposited[1] += (p1.status == Status::Deposited) as usize;
+        }
+    }
+    assert_eq!(deposited[0], centroids.len(), "without lift every near-wall grain settles: {deposited:?}");
+    assert!(deposited[1] < deposited[0], "the lift keeps some grains airborne: {deposited:?}");
+}

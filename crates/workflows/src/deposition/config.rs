@@ -97,7 +97,7 @@ pub struct BodySpec {
     pub translate_m: Vec3,
     pub wall: WallRuleSpec,
     /// Distance from the wall at which the velocity is sampled for the wall-shear estimate τ_w ≈ μ u_t/h
-    /// \[m\] (only used with `max_wall_shear_pa`).
+    /// \[m\] (used with `max_wall_shear_pa` and by `[forces] wall_lift` without a fixed friction velocity).
     #[serde(default = "default_probe")]
     pub shear_probe_distance_m: f64,
     /// View direction (from the camera towards the body) of the deposit picture.

@@ -106,7 +106,8 @@ pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
     Ok(Field::Imported(Box::new(ImportedField::load(&files, &opts)?)))
 }
 
-/// Loads the bodies of `cfg`; wall shear is estimated from `field` where a rule needs it.
+/// Loads the bodies of `cfg`; wall shear is estimated from `field` where a rule needs it or where the
+/// wall lift takes its friction velocity from it.
 pub fn build_bodies(cfg: &DepositionConfig, field: &Field) -> Result<Vec<Body>, DepositionError> {
     let mut out = Vec::new();
     for b in &cfg.bodies {
@@ -118,7 +119,8 @@ pub fn build_bodies(cfg: &DepositionConfig, field: &Field) -> Result<Vec<Body>, 
         }
         let rule = WallRule::from_spec(&b.wall, cfg.base_dir.as_deref())?;
         let mut body = Body::new(b.name.clone(), mesh, rule);
-        if matches!(b.wall, WallRuleSpec::RegimeMap { max_wall_shear_pa: Some(_), .. }) {
+        let lift_needs_shear = cfg.forces.wall_lift.is_some_and(|w| w.friction_velocity.is_none());
+        if lift_needs_shear || matches!(b.wall, WallRuleSpec::RegimeMap { max_wall_shear_pa: Some(_), .. }) {
             let mut hint = NONE;
             body.estimate_wall_shear(cfg.fluid.viscosity, b.shear_probe_distance_m, |p| {
                 field.sample(p, 0.0, &mut hint, false).map(|s| s.u)
@@ -181,6 +183,9 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     };
     if cfg.dispersion.is_some() && !field.has_turbulence() {
         tracing::warn!("dispersion is on but the flow field has no k and ε: the random walk does nothing");
+    }
+    if cfg.forces.wall_lift.is_some() && cfg.bodies.is_empty() {
+        tracing::warn!("forces.wall_lift is on but there are no [[bodies]]: the wall lift does nothing");
     }
     let model = ForceModel::new(cfg.fluid, cfg.forces.clone());
     let mut tr = Tracker::new(field, model, settings, bodies);

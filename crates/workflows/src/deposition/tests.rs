@@ -202,3 +202,46 @@ fn bad_inputs_are_named() {
     let e = errs.iter().find(|e| e.key == "time.dt_s").unwrap();
     assert_eq!(e.message, "dt_s = 0 must be a positive number");
 }
+
+#[test]
+fn wall_lift_key_uses_the_wall_shear_estimate_and_changes_the_run_only_when_on() {
+    use spatter_flow::forces::wall_lift::WallLiftSettings;
+    // The test scenario with a planar stagnation flow added to its uniform stream: u = (3 + a x, 0, −2 − a z)
+    // with a = 2 s⁻¹. With `[forces] wall_lift` on (u_* from the estimate) the plate's wall shear is
+    // estimated at h = 0.1 mm: τ_w = μ|u_t(h)|/h = μ|3 + a x_c|/h per triangle (x_c the centroid), checked
+    // to 1e-12 relative in the body VTU. Without the key nothing is estimated (zeros) and the run differs.
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = scenario(dir.path());
+    let (a, h) = (2.0, 1e-4);
+    cfg.flow.analytic.push(AnalyticField::StagnationPoint {
+        strain_rate: a,
+        centre: Vec3::ZERO,
+        normal: Vec3::Z,
+        axisymmetric: false,
+    });
+    cfg.bodies[0].shear_probe_distance_m = h;
+    cfg.output.parcels = false;
+    let mut on = cfg.clone();
+    on.forces.wall_lift = Some(WallLiftSettings::default());
+    let (out_off, out_on) = (dir.path().join("off"), dir.path().join("on"));
+    run_in(&cfg, &out_off, &Unattended, false);
+    run_in(&on, &out_on, &Unattended, false);
+    let vtu = spatter_io::vtu::read(&out_on.join("bodies/plate.vtu")).unwrap();
+    let tau = &vtu.cell_data["wall_shear_estimate_pa"].1;
+    let mut plate = TriMesh::rectangle(1.0, 1.0, 0.0, 8, 8);
+    plate.map_vertices(|v| v - Vec3::new(0.5, 0.5, 0.0));
+    assert_eq!(tau.len(), plate.triangles.len());
+    let mu = cfg.fluid.viscosity;
+    for (t, got) in tau.iter().enumerate() {
+        let expect = mu * (3.0 + a * plate.centroid(t).x).abs() / h;
+        assert!((got - expect).abs() <= 1e-12 * expect, "triangle {t}: {got} vs {expect}");
+    }
+    let vtu_off = spatter_io::vtu::read(&out_off.join("bodies/plate.vtu")).unwrap();
+    assert!(vtu_off.cell_data["wall_shear_estimate_pa"].1.iter().all(|&v| v == 0.0));
+    let balance = |d: &Path| std::fs::read_to_string(d.join("balance.csv")).unwrap();
+    assert_ne!(balance(&out_off), balance(&out_on), "the lift changed no trajectory");
+    // The same run without the key again gives the same file: the switch is the only difference.
+    let again = dir.path().join("off_again");
+    run_in(&cfg, &again, &Unattended, false);
+    assert_eq!(balance(&out_off), balance(&again));
+}
