@@ -14,8 +14,10 @@
 //!   and an exponential tail for older history, Odar–Hamilton and Reeks–McKee corrections;
 //! * [`inertial`] — added mass, pressure gradient (fluid acceleration), gravity and buoyancy;
 //! * [`model`] — a switchable set of all of them as used by the tracker;
-//! * [`ranking`] — nondimensional reference magnitudes (Jasion Table 6.4) and the asperity constants.
+//! * [`ranking`] — nondimensional reference magnitudes (Jasion Table 6.4) and the asperity constants;
+//! * [`contact`] — pull-off forces (JKR, DMT) and their inverse, damping ratio from restitution.
 
+pub mod contact;
 pub mod drag;
 pub mod history;
 pub mod inertial;
