@@ -20,7 +20,8 @@
 //! * **bounce** — no contact is left and the particle moves away on a path that meets no partner;
 //! * **stick** — the mechanical energy left (kinetic + energy stored in the contacts, minus the motion of
 //!   the centre of mass of a free pair) is below the work needed to break every active contact
-//!   (Σ U_break; JKR W_neck = 0.935503 F_cδ_c, zero for laws without a neck), with a safety margin. Damping,
+//!   (Σ U_break; JKR W_neck = 0.935503 F_cδ_c, zero for laws without a neck), with a safety margin, and
+//!   the deepest overlap has passed its first maximum (so the maximum overlap is reported). Damping,
 //!   friction and breaking only remove energy, so such a particle can never leave;
 //! * otherwise at the **check time**, where the particle sticks if a contact is still active (thesis
 //!   criterion: the normal overlap persists) and, under [`StickCriterion::StaticTangential`], the contact
@@ -156,9 +157,13 @@ pub struct ImpactResult {
     pub rebound_velocity: [f64; 3],
     /// Realised normal restitution: rebound normal speed / impact normal speed (0 when stuck).
     pub restitution: f64,
-    /// Largest overlap over all contacts \[m\].
+    /// Largest overlap over all contacts up to the end of the run \[m\]. A run never ends before the
+    /// deepest overlap has passed its first maximum, so for sticks too this is at least the peak of the
+    /// first compression (on a flat wall or a single sphere the largest overlap of the whole impact: the
+    /// normal energy only decreases after it).
     pub max_overlap: f64,
-    /// Time from first touch to the last contact break \[s\]; for a stuck particle the time simulated.
+    /// Time from first touch to the last contact break \[s\]; for a stuck particle the time simulated
+    /// (to the early decision or the check time).
     pub contact_duration: f64,
     /// Slip speed of the contact point at the end \[m/s\].
     pub slip_speed: f64,
@@ -415,6 +420,11 @@ pub fn run_impact<L: ContactLaw>(
     let mut steps = 0u64;
     let needs_static = s.criterion == StickCriterion::StaticTangential
         && !(imp.tangential_speed == 0.0 && matches!(target, Target::Plane));
+    // The early "bound" decision waits until the deepest active overlap has passed its first maximum, so
+    // `max_overlap` of a stick is the peak of the first compression (a slow grain is provably bound
+    // right after first touch, long before it reaches its deepest overlap).
+    let mut peaked = false;
+    let mut last_overlap = loads.active_overlap;
 
     while steps < max_steps {
         // Velocity Verlet.
@@ -449,6 +459,8 @@ pub fn run_impact<L: ContactLaw>(
         t += dt;
         record(&mut trace, t, &b, &loads, slots.len());
         max_overlap = max_overlap.max(loads.max_overlap);
+        peaked |= loads.active_overlap < last_overlap;
+        last_overlap = loads.active_overlap;
         if !slots.is_empty() {
             last_contact_time = t;
             // Energy of the relative motion (the centre of mass of a free pair keeps its energy).
@@ -458,7 +470,8 @@ pub fn run_impact<L: ContactLaw>(
                 e += 0.5 * mp * b.vp.length_squared() + 0.5 * ip * b.wp.length_squared()
                     - 0.5 * total_mass * vcm.length_squared();
             }
-            if !needs_static
+            if peaked
+                && !needs_static
                 && e < loads.u_break - s.bound_margin * loads.u_break.abs().max(f64::MIN_POSITIVE)
             {
                 decision = Decision::Bound;

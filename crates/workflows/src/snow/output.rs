@@ -117,7 +117,10 @@ pub const IMPACT_COLUMNS: [&str; 20] = [
 ];
 
 /// Every impact, one row each (`case` numbers sensitivity cases; `decision` 0 separated, 1 bound, 2 check
-/// time).
+/// time). Units are in the column names. `max_overlap_m` is the largest overlap from first touch to the
+/// end of the run, at least the peak of the first compression for sticks too (runs are not ended before
+/// it); the `rebound_*` columns of a stick are its velocity when the run was decided, and its
+/// `contact_duration_s` the time simulated (docs/snow.md §1).
 pub fn write_impacts(path: &Path, sets: &[(usize, &[ImpactRecord])]) -> io::Result<()> {
     let mut csv = CsvSeries::create(path, &IMPACT_COLUMNS)?;
     for (case, records) in sets {
