@@ -727,6 +727,155 @@ mod tests {
         assert!(ImportedField::load(&files, &opts).unwrap_err().to_string().contains("period_s"));
     }
 
+    /// Writes `text` as `name` in a fresh folder and loads it as a steady field.
+    fn load_text(name: &str, text: &[u8]) -> ImportedField {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        ImportedField::load(&[(0.0, p)], &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Two cells of a sheared structured grid (3 × 2 × 2 points, i fastest), written by hand; U = lin(x)
+    /// at every point (values worked out by hand from `lin`).
+    const STRUCTURED_GRID: &str = "# vtk DataFile Version 3.0
+sheared block, hand-made
+ASCII
+DATASET STRUCTURED_GRID
+DIMENSIONS 3 2 2
+POINTS 12 double
+0 0 0   0.5 0.02 0.03   1 0.04 0.06
+0.1 0.4 0   0.6 0.42 0.03   1.1 0.44 0.06
+0 0.05 0.7   0.5 0.07 0.73   1 0.09 0.76
+0.1 0.45 0.7   0.6 0.47 0.73   1.1 0.49 0.76
+POINT_DATA 12
+VECTORS U double
+1 0 0.7   1.995 -1.495 0.75   2.99 -2.99 0.8
+0.8 -0.2 2.3   1.795 -1.695 2.35   2.79 -3.19 2.4
+1.3 0.0125 0.2   2.295 -1.4825 0.25   3.29 -2.9775 0.3
+1.1 -0.1875 1.8   2.095 -1.6825 1.85   3.09 -3.1775 1.9
+CELL_DATA 2
+SCALARS p float 1
+LOOKUP_TABLE default
+10 20
+";
+
+    /// A rectilinear grid with uneven spacing: x ∈ {0, 0.3, 1}, y ∈ {−1, 0.5}, z ∈ {2, 2.4}; U = lin(x).
+    const RECTILINEAR_GRID: &str = "# vtk DataFile Version 2.0
+uneven box, hand-made
+ASCII
+DATASET RECTILINEAR_GRID
+DIMENSIONS 3 2 2
+X_COORDINATES 3 float
+0 0.3 1.0
+Y_COORDINATES 2 float
+-1 0.5
+Z_COORDINATES 2 float
+2 2.4
+POINT_DATA 12
+VECTORS U double
+3 -0.25 -5.3   3.6 -1.15 -5.3   5 -3.25 -5.3
+1.5 0.125 0.7   2.1 -0.775 0.7   3.5 -2.875 0.7
+3.2 -0.25 -5.7   3.8 -1.15 -5.7   5.2 -3.25 -5.7
+1.7 0.125 0.3   2.3 -0.775 0.3   3.7 -2.875 0.3
+";
+
+    #[test]
+    fn legacy_structured_grid_is_read_and_a_linear_field_reproduced_exactly() {
+        let ds = crate::vtk::legacy::parse(STRUCTURED_GRID.as_bytes(), Path::new("s.vtk")).unwrap();
+        ds.check(Path::new("s.vtk")).unwrap();
+        // Points in file order (i fastest), two hexahedra in VTK's vertex order, cell data kept.
+        assert_eq!(ds.points.len(), 12);
+        assert_eq!(ds.points[4], Vec3::new(0.6, 0.42, 0.03));
+        assert_eq!(ds.points[11], Vec3::new(1.1, 0.49, 0.76));
+        assert_eq!(ds.cell_types, vec![ct::HEXAHEDRON; 2]);
+        assert_eq!(ds.cell(0), &[0, 1, 4, 3, 6, 7, 10, 9]);
+        assert_eq!(ds.cell(1), &[1, 2, 5, 4, 7, 8, 11, 10]);
+        assert_eq!(ds.cell_array("p").unwrap().values, vec![10.0, 20.0]);
+        // The hand values are lin(x) at the points (to the rounding of their decimal digits).
+        for (i, p) in ds.points.iter().enumerate() {
+            assert!((ds.point_array("U").unwrap().vec3(i) - lin(*p)).length() < 1e-14, "point {i}");
+        }
+        // Point interpolation on the tetrahedral split reproduces the linear field and its gradient
+        // (1e-11 at 500 random points).
+        let f = load_text("s.vtk", STRUCTURED_GRID.as_bytes());
+        assert_eq!(f.mode, Interpolation::Point);
+        assert_linear_exact(&f);
+    }
+
+    #[test]
+    fn legacy_rectilinear_grid_ascii_and_binary_reproduce_a_linear_field_exactly() {
+        let ds = crate::vtk::legacy::parse(RECTILINEAR_GRID.as_bytes(), Path::new("r.vtk")).unwrap();
+        assert_eq!(ds.points.len(), 12);
+        assert_eq!(ds.points[1], Vec3::new(0.3, -1.0, 2.0));
+        assert_eq!(ds.points[5], Vec3::new(1.0, 0.5, 2.0));
+        assert_eq!(ds.points[10], Vec3::new(0.3, 0.5, 2.4));
+        assert_eq!(ds.cell(1), &[1, 2, 5, 4, 7, 8, 11, 10]);
+        for (i, p) in ds.points.iter().enumerate() {
+            assert!((ds.point_array("U").unwrap().vec3(i) - lin(*p)).length() < 1e-14, "point {i}");
+        }
+        let f = load_text("r.vtk", RECTILINEAR_GRID.as_bytes());
+        assert_linear_exact(&f);
+        // The same grid as big-endian BINARY (float coordinates, double vectors): the same points (the
+        // coordinates rounded to f32, as the file stores them) and again the linear field.
+        let mut b: Vec<u8> =
+            b"# vtk DataFile Version 2.0\nuneven box\nBINARY\nDATASET RECTILINEAR_GRID\nDIMENSIONS 3 2 2\n"
+                .to_vec();
+        let axes: [(&str, &[f64]); 3] = [("X", &[0.0, 0.3, 1.0]), ("Y", &[-1.0, 0.5]), ("Z", &[2.0, 2.4])];
+        for (name, v) in axes {
+            b.extend_from_slice(format!("{name}_COORDINATES {} float\n", v.len()).as_bytes());
+            for x in v {
+                b.extend_from_slice(&(*x as f32).to_be_bytes());
+            }
+            b.push(b'\n');
+        }
+        b.extend_from_slice(b"POINT_DATA 12\nVECTORS U double\n");
+        let pts = ds.points.iter().map(|p| p.as_vec3().as_dvec3());
+        for p in pts.clone() {
+            for c in lin(p).to_array() {
+                b.extend_from_slice(&c.to_be_bytes());
+            }
+        }
+        let bin = crate::vtk::legacy::parse(&b, Path::new("rb.vtk")).unwrap();
+        assert_eq!(bin.points, pts.collect::<Vec<_>>());
+        let f = load_text("rb.vtk", &b);
+        assert_linear_exact(&f);
+    }
+
+    #[test]
+    fn k_omega_fields_are_converted_to_epsilon() {
+        // ε = β* k ω with β* = 0.09 (Wilcox 2006, k–ω model; OpenFOAM's kOmega/kOmegaSST betaStar),
+        // converted at the mesh points, then interpolated linearly like every point value. Two tetrahedra
+        // written by hand with k and ω varying per point: at each vertex ε = 0.09 k ω, at the centroid of
+        // the first tetrahedron the mean of its four vertex values (1e-12 relative).
+        let k = [0.5, 0.8, 1.2, 0.3, 2.0];
+        let omega = [100.0, 250.0, 40.0, 900.0, 10.0];
+        let text = |with_eps: bool| {
+            let mut t = String::from(
+                "# vtk DataFile Version 3.0\nk-omega, hand-made\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0  1 0 0  0 1 0  0 0 1  1 1 1\nCELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 2\n10 10\nPOINT_DATA 5\nVECTORS U double\n1 0 0 1 0 0 1 0 0 1 0 0 1 0 0\nSCALARS k double 1\nLOOKUP_TABLE default\n0.5 0.8 1.2 0.3 2.0\nSCALARS omega double 1\nLOOKUP_TABLE default\n100 250 40 900 10\n",
+            );
+            if with_eps {
+                t.push_str("SCALARS epsilon double 1\nLOOKUP_TABLE default\n7 7 7 7 7\n");
+            }
+            t
+        };
+        let f = load_text("kw.vtk", text(false).as_bytes());
+        assert!(f.has_turbulence());
+        let pts = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE];
+        let eps: Vec<f64> = (0..5).map(|i| 0.09 * k[i] * omega[i]).collect();
+        let mut h = NONE;
+        for i in 0..5 {
+            let s = f.sample(pts[i], 0.0, &mut h, false).unwrap();
+            assert!((s.eps - eps[i]).abs() <= 1e-12 * eps[i], "vertex {i}: {} vs {}", s.eps, eps[i]);
+            assert!((s.k - k[i]).abs() <= 1e-12 * k[i]);
+        }
+        let s = f.sample(Vec3::splat(0.25), 0.0, &mut h, false).unwrap();
+        let mean = 0.25 * (eps[0] + eps[1] + eps[2] + eps[3]);
+        assert!((s.eps - mean).abs() <= 1e-12 * mean, "centroid: {} vs {mean}", s.eps);
+        // An ε array wins over ω.
+        let f = load_text("ke.vtk", text(true).as_bytes());
+        assert!((f.sample(Vec3::splat(0.25), 0.0, &mut h, false).unwrap().eps - 7.0).abs() < 1e-12);
+    }
+
     #[test]
     fn missing_velocity_is_named() {
         let ds = tet_dataset(1);
