@@ -9,8 +9,9 @@
 //! * `<name>_deposit.png` — the chosen statistic on the body, seen from the body's view direction;
 //! * `deposit_summary.csv` — one row per body.
 //!
-//! Stopping (Ctrl-C) writes `checkpoint.bin` after a whole step; resuming continues from it and gives
-//! the same files as an uninterrupted run.
+//! Stopping (Ctrl-C) writes `checkpoint.bin` after a whole step and the body outputs (VTU, picture,
+//! summary) from the deposits so far, marked partial in the log and the picture title; resuming continues
+//! from the checkpoint and gives the same files as an uninterrupted run.
 
 use super::config::{DepositionConfig, PictureQuantity};
 use serde::{Deserialize, Serialize};
@@ -57,13 +58,13 @@ pub enum DepositionError {
 
 /// What `checkpoint.bin` holds.
 #[derive(Serialize, Deserialize)]
-struct Checkpoint {
+pub(super) struct Checkpoint {
     /// The configuration that wrote it (JSON), compared on resume.
-    config: String,
-    state: TrackerState,
-    injectors: Vec<InjectorState>,
-    next_output: u64,
-    csv_bytes: u64,
+    pub(super) config: String,
+    pub(super) state: TrackerState,
+    pub(super) injectors: Vec<InjectorState>,
+    pub(super) next_output: u64,
+    pub(super) csv_bytes: u64,
 }
 
 const BALANCE_COLUMNS: [&str; 9] = [
@@ -278,6 +279,18 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
             tr.state.step,
             ckpt.display()
         ));
+        // The deposit so far, so an interrupted run still shows where things landed; a resumed run
+        // rewrites these files when it ends (identical to an uninterrupted run).
+        if !cfg.bodies.is_empty() {
+            write_bodies(cfg, &tr, ctx, &mut s, Some(tr.state.time))?;
+            let note = format!(
+                "PARTIAL deposit outputs (bodies/*.vtu, *_deposit.png, deposit_summary.csv) written from the \
+                 deposits up to t = {:.6} s; `--resume` continues the run and replaces them at its end",
+                tr.state.time
+            );
+            tracing::info!("{note}");
+            s.headline.push(note);
+        }
         return Ok(s);
     }
     if last_written_step != tr.state.step {
@@ -289,7 +302,7 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     if cfg.output.parcels {
         summary.artifacts.push(("parcel snapshots".into(), pvd_path.clone()));
     }
-    write_bodies(cfg, &tr, ctx, &mut summary)?;
+    write_bodies(cfg, &tr, ctx, &mut summary, None)?;
     let b = &tr.state.balance;
     let (inj, rhs) = tr.mass_balance();
     let line = format!(
@@ -311,12 +324,16 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     Ok(summary)
 }
 
+/// Writes every body's VTU and picture and `deposit_summary.csv` from the deposits so far; `partial` is
+/// the time of an interrupted run (named in the picture titles and the summary lines).
 fn write_bodies(
     cfg: &DepositionConfig,
     tr: &Tracker<Field>,
     ctx: &RunContext,
     summary: &mut RunSummary,
+    partial: Option<f64>,
 ) -> Result<(), DepositionError> {
+    let partial_note = partial.map(|t| format!(" (partial, t = {t:.6} s)")).unwrap_or_default();
     let mut rows = Vec::new();
     for (k, (body, spec)) in tr.bodies.iter().zip(&cfg.bodies).enumerate() {
         let d = &tr.state.deposits[k];
@@ -348,7 +365,7 @@ fn write_bodies(
             &values,
             spec.view_direction,
             spec.view_up,
-            &format!("{}: {}", body.name, label.split(" [").next().unwrap_or(label)),
+            &format!("{}: {}{partial_note}", body.name, label.split(" [").next().unwrap_or(label)),
             label,
         )?;
         summary.artifacts.push((format!("{} deposit (PNG)", body.name), png));
@@ -357,7 +374,7 @@ fn write_bodies(
         let impacts: u64 = d.impacts.iter().sum();
         let peak = mpa.iter().copied().fold(0.0, f64::max);
         summary.headline.push(format!(
-            "{}: deposited {:.4e} kg on {:.4e} m² ({} impacts), peak {:.4e} kg/m²",
+            "{}: deposited {:.4e} kg on {:.4e} m² ({} impacts), peak {:.4e} kg/m²{partial_note}",
             body.name, mass, area, impacts, peak
         ));
         rows.push(vec![

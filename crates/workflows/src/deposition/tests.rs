@@ -107,13 +107,31 @@ fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
     let s = run_in(&cfg, &b, &StopAfterPolls::new(137), false);
     assert_eq!(s.finished, spatter_core::control::Finished::Interrupted);
     assert!(b.join("checkpoint.bin").is_file());
+    // The interrupted run wrote the body outputs from the deposits so far, and says they are partial.
+    // Their content is the checkpoint's: the VTU's per-triangle masses add up to the exactly summed
+    // deposited mass of the balance (1e-12 relative) and its impacts to the deposit's impact count.
+    assert!(b.join("plate_deposit.png").is_file() && b.join("deposit_summary.csv").is_file());
+    assert!(s.headline.iter().any(|l| l.contains("PARTIAL") && l.contains("--resume")), "{:?}", s.headline);
+    let ck: super::run::Checkpoint = spatter_io::checkpoint::load(&b.join("checkpoint.bin")).unwrap();
+    let vtu = spatter_io::vtu::read(&b.join("bodies/plate.vtu")).unwrap();
+    let partial_mass: f64 = vtu.cell_data["deposited_mass_kg"].1.iter().sum();
+    let exact = ck.state.balance.deposited.value();
+    assert!(exact > 0.0, "nothing deposited before the interrupt: pick a later one");
+    assert!((partial_mass - exact).abs() <= 1e-12 * exact, "{partial_mass} vs {exact}");
+    let partial_impacts: f64 = vtu.cell_data["impacts"].1.iter().sum();
+    assert_eq!(partial_impacts, ck.state.deposits[0].impacts.iter().sum::<u64>() as f64);
     let s = run_in(&cfg, &b, &StopAfterPolls::new(100), true);
     assert_eq!(s.finished, spatter_core::control::Finished::Interrupted, "stopped twice");
     let s = run_in(&cfg, &b, &Unattended, true);
     assert_eq!(s.finished, spatter_core::control::Finished::Completed);
-    for f in
-        ["balance.csv", "bodies/plate.vtu", "deposit_summary.csv", "parcels.pvd", "parcels/parcels_00005.vtu"]
-    {
+    for f in [
+        "balance.csv",
+        "bodies/plate.vtu",
+        "deposit_summary.csv",
+        "plate_deposit.png",
+        "parcels.pvd",
+        "parcels/parcels_00005.vtu",
+    ] {
         assert_eq!(
             std::fs::read(a.join(f)).unwrap(),
             std::fs::read(b.join(f)).unwrap(),
