@@ -5,6 +5,7 @@
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use spatter_core::mesh::TriMesh;
 use spatter_core::Vec3;
 use std::io;
@@ -326,9 +327,44 @@ pub fn viridis(t: f64) -> (u8, u8, u8) {
     (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// A coordinate axis as seen on a picture (see [`axis_triad`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenAxis {
+    /// `x`, `y` or `z`.
+    pub label: &'static str,
+    /// Projected direction (right, up) on the screen: unit length for an axis in the picture plane,
+    /// shorter as it tilts towards the viewing direction.
+    pub screen: (f64, f64),
+    /// Component along the view direction (> 0: the axis points away from the viewer, into the picture).
+    pub along: f64,
+}
+
+/// The x, y and z axes as seen on a picture looking along `view_dir` with `up` towards the top; `None`
+/// when `view_dir` and `up` are zero or parallel.
+pub fn axis_triad(view_dir: Vec3, up: Vec3) -> Option<[ScreenAxis; 3]> {
+    let d = view_dir.normalize_or_zero();
+    let right = d.cross(up).normalize_or_zero();
+    if d == Vec3::ZERO || right == Vec3::ZERO {
+        return None;
+    }
+    let screen_up = right.cross(d);
+    let axis =
+        |label, e: Vec3| ScreenAxis { label, screen: (e.dot(right), e.dot(screen_up)), along: e.dot(d) };
+    Some([axis("x", Vec3::X), axis("y", Vec3::Y), axis("z", Vec3::Z)])
+}
+
+/// The caption of a mesh picture naming its view: `view direction [a, b, c] (camera → object), up [u, v, w]`.
+pub fn view_caption(view_dir: Vec3, up: Vec3) -> String {
+    let v = |a: Vec3| format!("[{}, {}, {}]", tick_label(a.x), tick_label(a.y), tick_label(a.z));
+    format!("view direction {} (camera → object), up {}", v(view_dir), v(up))
+}
+
 /// Renders `mesh` seen along `view_dir` (orthographic, `up` towards the top of the picture), each triangle
 /// coloured by its value; NaN values are drawn grey ("no data"). A colour bar labelled `colorbar_label`
-/// shows the scale from 0 (or the minimum, if negative) to the maximum.
+/// shows the scale from 0 (or the minimum, if negative) to the maximum; an axis triad (x red, y green,
+/// z blue, drawn as arrows in the picture plane, an axis along the view as a circle with a dot when it
+/// points at the viewer or a cross when it points away) and a caption with the view direction and up
+/// vector give the orientation. The picture has no other axes or ticks: the mesh is drawn to scale.
 pub fn mesh_map_png(
     path: &Path,
     mesh: &TriMesh,
@@ -342,11 +378,11 @@ pub fn mesh_map_png(
         return Err(err(path, format!("{} values for {} triangles", values.len(), mesh.triangles.len())));
     }
     ensure_font();
+    let Some(triad) = axis_triad(view_dir, up) else {
+        return Err(err(path, "view direction and up vector must be non-zero and not parallel"));
+    };
     let d = view_dir.normalize_or_zero();
     let right = d.cross(up).normalize_or_zero();
-    if d == Vec3::ZERO || right == Vec3::ZERO {
-        return Err(err(path, "view direction and up vector must be non-zero and not parallel"));
-    }
     let screen_up = right.cross(d);
     let project = |p: Vec3| (p.dot(right), p.dot(screen_up));
     let (mut x0, mut x1, mut y0, mut y1) =
@@ -371,24 +407,25 @@ pub fn mesh_map_png(
     let depth: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.centroid(t).dot(d)).collect();
     order.sort_by(|&a, &b| depth[b].total_cmp(&depth[a]));
 
-    // Keep the picture's aspect equal to the geometry's.
+    // Layout (pixels): the mesh to scale in [20, 830] × [50, 700], the caption below it, the colour bar
+    // and the axis triad in the right-hand column.
     let (w, h) = (1000u32, 760u32);
-    let plot_w = w - 150;
+    let (mx0, mx1, my0, my1) = (20.0, 830.0, 50.0, 700.0);
     let span_x = (x1 - x0).max(1e-300);
     let span_y = (y1 - y0).max(1e-300);
-    let scale = ((plot_w - 60) as f64 / span_x).min((h - 110) as f64 / span_y);
-    let cx = 0.5 * (x0 + x1);
-    let cy = 0.5 * (y0 + y1);
-    let half_x = 0.5 * (plot_w - 60) as f64 / scale;
-    let half_y = 0.5 * (h - 110) as f64 / scale;
+    let scale = ((mx1 - mx0) / span_x).min((my1 - my0) / span_y);
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let (px_c, py_c) = (0.5 * (mx0 + mx1), 0.5 * (my0 + my1));
+    let to_px = |(x, y): (f64, f64)| -> (i32, i32) {
+        ((px_c + (x - cx) * scale).round() as i32, (py_c - (y - cy) * scale).round() as i32)
+    };
 
     let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| err(path, x))?;
-    let (left, bar) = root.split_horizontally(plot_w);
-    let mut chart = ChartBuilder::on(&left)
-        .caption(title, ("sans-serif", 22))
-        .margin(20)
-        .build_cartesian_2d((cx - half_x)..(cx + half_x), (cy - half_y)..(cy + half_y))
+    let centred = |size: u32| {
+        TextStyle::from(("sans-serif", size).into_font()).pos(Pos::new(HPos::Center, VPos::Center))
+    };
+    root.draw(&Text::new(title.to_owned(), (((mx0 + mx1) / 2.0) as i32, 24), centred(22)))
         .map_err(|x| err(path, x))?;
     let shade = |v: f64| -> RGBColor {
         if v.is_finite() {
@@ -398,38 +435,90 @@ pub fn mesh_map_png(
             RGBColor(200, 200, 200)
         }
     };
-    chart
-        .draw_series(order.iter().map(|&t| {
-            let [a, b, c] = mesh.corners(t);
-            Polygon::new(vec![project(a), project(b), project(c)], shade(values[t]).filled())
-        }))
+    for &t in &order {
+        let [a, b, c] = mesh.corners(t);
+        let poly = vec![to_px(project(a)), to_px(project(b)), to_px(project(c))];
+        root.draw(&Polygon::new(poly, shade(values[t]).filled())).map_err(|x| err(path, x))?;
+    }
+    root.draw(&Text::new(view_caption(view_dir, up), (mx0 as i32, 734), ("sans-serif", 14)))
         .map_err(|x| err(path, x))?;
-    // Colour bar.
-    let bar_top = 80i32;
-    let bar_bottom = h as i32 - 80;
+
+    // Colour bar with labelled ticks.
+    let (bar_x0, bar_x1) = (870i32, 895i32);
+    let (bar_top, bar_bottom) = (80i32, 520i32);
     let steps = 100;
     let y_at = |f: f64| bar_bottom - ((bar_bottom - bar_top) as f64 * f).round() as i32;
     for k in 0..steps {
         let t0 = k as f64 / steps as f64;
         let (y_hi, y_lo) = (y_at((k + 1) as f64 / steps as f64), y_at(t0));
         let (r, g, b) = viridis(t0);
-        bar.draw(&Rectangle::new([(20, y_hi), (45, y_lo)], RGBColor(r, g, b).filled()))
+        root.draw(&Rectangle::new([(bar_x0, y_hi), (bar_x1, y_lo)], RGBColor(r, g, b).filled()))
             .map_err(|x| err(path, x))?;
     }
-    bar.draw(&Rectangle::new([(20, bar_top), (45, bar_bottom)], BLACK.stroke_width(1)))
+    root.draw(&Rectangle::new([(bar_x0, bar_top), (bar_x1, bar_bottom)], BLACK.stroke_width(1)))
         .map_err(|x| err(path, x))?;
     for k in 0..=4 {
         let f = k as f64 / 4.0;
-        let y = bar_bottom - ((bar_bottom - bar_top) as f64 * f) as i32;
+        let y = y_at(f);
+        root.draw(&PathElement::new(vec![(bar_x1, y), (bar_x1 + 4, y)], BLACK.stroke_width(1)))
+            .map_err(|x| err(path, x))?;
         let label = tick_label(vmin + f * (vmax - vmin));
-        bar.draw(&Text::new(label, (50, y - 7), ("sans-serif", 13))).map_err(|x| err(path, x))?;
+        root.draw(&Text::new(label, (bar_x1 + 7, y - 7), ("sans-serif", 13))).map_err(|x| err(path, x))?;
     }
     // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
     let lines = wrap_words(colorbar_label, 20);
     let first = bar_top - 12 - 16 * lines.len() as i32;
     for (k, line) in lines.iter().enumerate() {
-        bar.draw(&Text::new(line.clone(), (5, first + 16 * k as i32), ("sans-serif", 14)))
+        root.draw(&Text::new(line.clone(), (855, first + 16 * k as i32), ("sans-serif", 14)))
             .map_err(|x| err(path, x))?;
+    }
+
+    // Axis triad: arrows of length `len` from the origin `o`, far axes first so near ones stay on top.
+    let o = (925.0, 640.0);
+    let len = 48.0;
+    root.draw(&Text::new("axes", (o.0 as i32, 568), centred(13))).map_err(|x| err(path, x))?;
+    let mut axes = triad;
+    axes.sort_by(|a, b| b.along.total_cmp(&a.along));
+    for ScreenAxis { label, screen: (ex, ey), along } in axes {
+        let colour = match label {
+            "x" => RGBColor(200, 30, 30),
+            "y" => RGBColor(20, 140, 20),
+            _ => RGBColor(30, 60, 210),
+        };
+        let pt = |x: f64, y: f64| (x.round() as i32, y.round() as i32);
+        let flat = (ex * ex + ey * ey).sqrt();
+        if flat < 0.2 {
+            // Along the view: ⊙ pointing at the viewer, ⊗ pointing away.
+            let c = pt(o.0, o.1);
+            root.draw(&Circle::new(c, 7, colour.stroke_width(2))).map_err(|x| err(path, x))?;
+            if along < 0.0 {
+                root.draw(&Circle::new(c, 2, colour.filled())).map_err(|x| err(path, x))?;
+            } else {
+                for (a, b) in [((-4, -4), (4, 4)), ((-4, 4), (4, -4))] {
+                    let seg = vec![(c.0 + a.0, c.1 + a.1), (c.0 + b.0, c.1 + b.1)];
+                    root.draw(&PathElement::new(seg, colour.stroke_width(2))).map_err(|x| err(path, x))?;
+                }
+            }
+            root.draw(&Text::new(label, (c.0 + 9, c.1 - 22), ("sans-serif", 16).into_font().color(&colour)))
+                .map_err(|x| err(path, x))?;
+            continue;
+        }
+        let tip = (o.0 + len * ex, o.1 - len * ey);
+        let (ux, uy) = (ex / flat, -ey / flat);
+        let head = 9.0_f64.min(len * flat);
+        let base = (tip.0 - head * ux, tip.1 - head * uy);
+        root.draw(&PathElement::new(vec![pt(o.0, o.1), pt(base.0, base.1)], colour.stroke_width(2)))
+            .map_err(|x| err(path, x))?;
+        let wing = 0.45 * head;
+        let arrow = vec![
+            pt(tip.0, tip.1),
+            pt(base.0 - wing * uy, base.1 + wing * ux),
+            pt(base.0 + wing * uy, base.1 - wing * ux),
+        ];
+        root.draw(&Polygon::new(arrow, colour.filled())).map_err(|x| err(path, x))?;
+        let at = pt(tip.0 + 11.0 * ux, tip.1 + 11.0 * uy);
+        let style = ("sans-serif", 16).into_font().color(&colour).pos(Pos::new(HPos::Center, VPos::Center));
+        root.draw(&Text::new(label, at, style)).map_err(|x| err(path, x))?;
     }
     root.present().map_err(|x| err(path, x))
 }
@@ -479,6 +568,35 @@ mod tests {
         assert_eq!(axis_tick_label(2.711e-20, 1.4e-3), "0");
         assert_eq!(axis_tick_label(2e-4, 1.4e-3), "2e-4");
         assert_eq!(axis_tick_label(2.711e-20, 0.0), "2.711e-20");
+    }
+
+    #[test]
+    fn axis_triad_and_caption_follow_the_view() {
+        // Looking down (−z) with y up: right = d × up = x, so x points right, y up, z at the viewer.
+        let t = axis_triad(-Vec3::Z, Vec3::Y).unwrap();
+        assert_eq!(t.map(|a| a.label), ["x", "y", "z"]);
+        assert_eq!(t[0].screen, (1.0, 0.0));
+        assert_eq!(t[1].screen, (0.0, 1.0));
+        assert_eq!((t[2].screen, t[2].along), ((0.0, 0.0), -1.0));
+        // Isometric view along −(1, 1, 1) with z up: every axis projects to length √(2/3) (orthographic
+        // projection of a unit vector at angle acos(1/√3) to the view), z straight up, x and y 30° below
+        // the horizontal on either side; each axis has component −1/√3 along the view (towards the viewer).
+        let t = axis_triad(-Vec3::ONE, Vec3::Z).unwrap();
+        let s = (2.0f64 / 3.0).sqrt();
+        for a in t {
+            let (ex, ey) = a.screen;
+            assert!(((ex * ex + ey * ey).sqrt() - s).abs() < 1e-15);
+            assert!((a.along + 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        }
+        let ((xx, xy), (yx, _), (zx, zy)) = (t[0].screen, t[1].screen, t[2].screen);
+        assert!(zx.abs() < 1e-15 && (zy - s).abs() < 1e-15, "z up: {:?}", t[2].screen);
+        assert!((xy / xx.abs() + 30f64.to_radians().tan()).abs() < 1e-15, "x 30° down");
+        assert!(xx * yx < 0.0, "x and y on opposite sides");
+        assert!(axis_triad(Vec3::Z, Vec3::Z).is_none());
+        assert_eq!(
+            view_caption(Vec3::new(0.6, 1.0, -0.9), Vec3::Z),
+            "view direction [0.6, 1, -0.9] (camera → object), up [0, 0, 1]"
+        );
     }
 
     #[test]
