@@ -33,6 +33,11 @@ pub struct CriticalSpeed {
     pub status: BracketStatus,
     /// Impacts simulated.
     pub impacts: u32,
+    /// Impacts of the search that created energy ([`ImpactResult::created_energy`]): a numerical
+    /// failure that makes the result untrustworthy.
+    ///
+    /// [`ImpactResult::created_energy`]: super::impact::ImpactResult::created_energy
+    pub energy_created: u32,
 }
 
 /// Finds v_crit for diameter `d` \[m\] starting from the bracket [`low`, `high`] \[m/s\].
@@ -45,9 +50,12 @@ pub fn critical_speed(
     max_expansions: u32,
 ) -> CriticalSpeed {
     let mut impacts = 0u32;
+    let mut energy_created = 0u32;
     let mut sticks = |v: f64| {
         impacts += 1;
-        model.simulate(d, v, 0.0, [0.0, 0.0], Surface::Configured).0.outcome == Outcome::Stick
+        let r = model.simulate(d, v, 0.0, [0.0, 0.0], Surface::Configured).0;
+        energy_created += u32::from(r.created_energy());
+        r.outcome == Outcome::Stick
     };
     let (mut lo, mut hi) = (low.min(high), low.max(high));
     let mut k = 0;
@@ -60,6 +68,7 @@ pub fn critical_speed(
                 high: lo,
                 status: BracketStatus::BelowRange,
                 impacts,
+                energy_created,
             };
         }
         hi = lo;
@@ -76,6 +85,7 @@ pub fn critical_speed(
                 high: f64::INFINITY,
                 status: BracketStatus::AboveRange,
                 impacts,
+                energy_created,
             };
         }
         lo = hi;
@@ -97,5 +107,6 @@ pub fn critical_speed(
         high: hi,
         status: BracketStatus::Found,
         impacts,
+        energy_created,
     }
 }

@@ -781,5 +781,18 @@ impl Validate for SnowConfig {
             }
         }
         c.item("single", &self.single);
+        // A fixed time step above 1/8 of the shortest Hertz time of the run is refused (snow::dt_guard);
+        // checked only when everything else is valid, since the Hertz times need valid values.
+        if let Some(dt) = self.integration.dt_s {
+            if dt.is_finite() && dt > 0.0 {
+                let mut rest = self.clone();
+                rest.integration.dt_s = None;
+                if Checker::run(&rest, None).is_ok() {
+                    if let Some(msg) = super::dt_guard::refusal(self) {
+                        c.nested("integration", |c| c.fail("dt_s", msg));
+                    }
+                }
+            }
+        }
     }
 }

@@ -4,6 +4,7 @@ pub mod bed;
 pub mod bed_index;
 pub mod bisection;
 pub mod config;
+pub mod dt_guard;
 pub mod fit;
 pub mod impact;
 pub mod material;

@@ -93,7 +93,7 @@ impl Axes {
 }
 
 /// Column names of [`write_impacts`].
-pub const IMPACT_COLUMNS: [&str; 20] = [
+pub const IMPACT_COLUMNS: [&str; 22] = [
     "case",
     "diameter_m",
     "normal_speed_m_s",
@@ -114,13 +114,19 @@ pub const IMPACT_COLUMNS: [&str; 20] = [
     "dt_s",
     "hertz_time_s",
     "steps",
+    "energy_ratio",
+    "energy_created",
 ];
 
 /// Every impact, one row each (`case` numbers sensitivity cases; `decision` 0 separated, 1 bound, 2 check
 /// time). Units are in the column names. `max_overlap_m` is the largest overlap from first touch to the
 /// end of the run, at least the peak of the first compression for sticks too (runs are not ended before
 /// it); the `rebound_*` columns of a stick are its velocity when the run was decided, and its
-/// `contact_duration_s` the time simulated (docs/snow.md §1).
+/// `contact_duration_s` the time simulated (docs/snow.md §1). `energy_ratio` is the rebound's kinetic
+/// energy over the impact's (0 for sticks) and `energy_created` is 1 when it exceeds 1 + 1e-3: energy made
+/// by the integration, a numerical failure ([`ImpactResult::created_energy`]).
+///
+/// [`ImpactResult::created_energy`]: super::impact::ImpactResult::created_energy
 pub fn write_impacts(path: &Path, sets: &[(usize, &[ImpactRecord])]) -> io::Result<()> {
     let mut csv = CsvSeries::create(path, &IMPACT_COLUMNS)?;
     for (case, records) in sets {
@@ -147,6 +153,8 @@ pub fn write_impacts(path: &Path, sets: &[(usize, &[ImpactRecord])]) -> io::Resu
                 r.dt,
                 r.hertz_time,
                 r.result.steps as f64,
+                r.result.energy_ratio,
+                if r.result.created_energy() { 1.0 } else { 0.0 },
             ])?;
         }
     }
@@ -189,6 +197,7 @@ pub fn write_critical_speeds(path: &Path, speeds: &[CriticalSpeed]) -> io::Resul
             "lowest_bounce_m_s",
             "status",
             "impacts",
+            "energy_created",
         ],
     )?;
     for c in speeds {
@@ -197,7 +206,7 @@ pub fn write_critical_speeds(path: &Path, speeds: &[CriticalSpeed]) -> io::Resul
             BracketStatus::BelowRange => -1.0,
             BracketStatus::AboveRange => 1.0,
         };
-        csv.row(&[c.diameter, c.v_crit, c.low, c.high, status, c.impacts as f64])?;
+        csv.row(&[c.diameter, c.v_crit, c.low, c.high, status, c.impacts as f64, c.energy_created as f64])?;
     }
     csv.flush()
 }

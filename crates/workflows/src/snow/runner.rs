@@ -153,6 +153,10 @@ fn completed(ctx: &RunContext<'_>) {
 /// Runs the `snow_regime_map` scenario `cfg` into `ctx.dir`.
 pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
     Checker::run(cfg, None).map_err(SnowError::Invalid)?;
+    let dt_warning = super::dt_guard::warning(cfg);
+    if let Some(w) = &dt_warning {
+        tracing::warn!("{w}");
+    }
     let mut summary = match cfg.mode {
         Mode::Grid => run_grid(cfg, ctx)?,
         Mode::Bisection => run_bisection(cfg, ctx)?,
@@ -162,6 +166,9 @@ pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowErr
     };
     if summary.finished == Finished::Completed {
         let mut lines = material_report(cfg);
+        if let Some(w) = dt_warning {
+            lines.push(format!("warning: {w}"));
+        }
         lines.append(&mut summary.headline);
         summary.headline = lines;
         let log = summary.headline.join("\n") + "\n";
@@ -271,6 +278,25 @@ pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
     out
 }
 
+/// Adds the energy check of `impacts` simulated impacts, `created` of which left with more kinetic energy
+/// than they came with (a numerical failure), to the summary; warns when there are any. `marked` names
+/// the file and column where they are flagged.
+fn energy_check(s: &mut RunSummary, created: usize, impacts: usize, marked: &str) {
+    if created == 0 {
+        s.headline.push(format!(
+            "energy check: none of {impacts} impacts left with more kinetic energy than it came with"
+        ));
+    } else {
+        let msg = format!(
+            "warning: {created} of {impacts} impacts left with more kinetic energy than they came with (by more \
+             than 0.1 %): energy created by the time integration, a numerical failure, so their outcomes are \
+             not to be trusted ({marked}); reduce the time step (docs/snow.md §3)"
+        );
+        tracing::warn!("{msg}");
+        s.headline.push(msg);
+    }
+}
+
 fn description(cfg: &SnowConfig, extra: &str) -> String {
     format!(
         "snow_regime_map {extra}: particle E = {} Pa, nu = {}, rho = {} kg/m3 on {:?} (wall E = {} Pa, nu = {}); \
@@ -311,6 +337,8 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
     let impacts = ctx.dir.path("impacts.csv");
     output::write_impacts(&impacts, &[(0, &p.records)])?;
     s.artifacts.push(("every impact".into(), impacts));
+    let created = p.records.iter().filter(|r| r.result.created_energy()).count();
+    energy_check(&mut s, created, p.records.len(), "energy_created = 1 in impacts.csv");
     let n_d = cfg.grid.diameters;
     let n_v = cfg.grid.normal_speeds;
     for (ai, angle) in cfg.grid.angles_deg.iter().enumerate() {
@@ -429,6 +457,13 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     let png = output::save_chart(&chart, ctx.dir, "critical_speed", cfg.svg)?;
     s.artifacts.push(("critical speed picture".into(), png));
     let impacts: u32 = p.critical.iter().map(|c| c.impacts).sum();
+    let created: u32 = p.critical.iter().map(|c| c.energy_created).sum();
+    energy_check(
+        &mut s,
+        created as usize,
+        impacts as usize,
+        "counted per diameter in the energy_created column of critical_speeds.csv",
+    );
     let found = points.len();
     s.headline.push(format!(
         "bisection: v_crit found for {found} of {} diameters with {impacts} impacts (relative tolerance {tol})",
@@ -473,6 +508,8 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
     let ipath = ctx.dir.path("sensitivity_impacts.csv");
     output::write_impacts(&ipath, &sets)?;
     s.artifacts.push(("every impact of every case".into(), ipath));
+    let created = p.records.iter().filter(|r| r.result.created_energy()).count();
+    energy_check(&mut s, created, p.records.len(), "energy_created = 1 in sensitivity_impacts.csv");
     let (n_d, n_v) = (cfg.grid.diameters, cfg.grid.normal_speeds);
     let mut rows = Vec::new();
     let mut chart = Chart::new(
@@ -621,6 +658,8 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     let ipath = ctx.dir.path("rough_impacts.csv");
     output::write_impacts(&ipath, &[(0, &p.records)])?;
     s.artifacts.push(("every rough-wall impact".into(), ipath));
+    let created = p.records.iter().filter(|r| r.result.created_energy()).count();
+    energy_check(&mut s, created, p.records.len(), "energy_created = 1 in rough_impacts.csv");
     // The bed for ParaView.
     let centres: Vec<Vec3> = bed.spheres.iter().map(|q| Vec3::from(q.centre)).collect();
     let radii: Vec<f64> = bed.spheres.iter().map(|q| q.radius).collect();
@@ -792,7 +831,7 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
     let png = output::save_chart(&chart, ctx.dir, "force_overlap", cfg.svg)?;
     s.artifacts.push(("force–overlap loop".into(), png));
     s.headline.push(format!(
-        "single impact d = {:.3e} m, v_n = {} m/s, v_t = {} m/s: {:?} ({:?}), restitution input {:.4}, realised {:.4}, max overlap {:.4e} m, contact {:.4e} s, {} steps of {:.4e} s",
+        "single impact d = {:.3e} m, v_n = {} m/s, v_t = {} m/s: {:?} ({:?}), restitution input {:.4}, realised {:.4}, rebound/impact kinetic energy {:.4}, max overlap {:.4e} m, contact {:.4e} s, {} steps of {:.4e} s",
         sc.diameter_m,
         sc.normal_speed_m_s,
         sc.tangential_speed_m_s,
@@ -800,10 +839,12 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
         r.decision,
         setup.restitution_input,
         r.restitution,
+        r.energy_ratio,
         r.max_overlap,
         r.contact_duration,
         r.steps,
         setup.dt
     ));
+    energy_check(&mut s, usize::from(r.created_energy()), 1, "see the kinetic energy ratio above");
     Ok(s)
 }
