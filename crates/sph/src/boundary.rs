@@ -3,10 +3,16 @@
 //!
 //! * **Lattice parts** (analytic boxes): `layers` lattice layers continue the fluid lattice behind each
 //!   closed face (first layer dp/2 behind the face), each particle with volume dp^d.
-//! * **Mesh parts** (STL/OBJ or generated meshes): one layer on the surface sampled by
-//!   [`spatter_core::surface_sample`], optional further layers offset by dp against the normal, each
-//!   particle with the Akinci et al. (2012) volume `V_b = 1 / Σ_k W_bk` (same-part neighbours), so that
-//!   irregular or thin samplings still fill the kernel support correctly.
+//! * **Solid mesh parts** (closed STL/OBJ surfaces and generated solids such as wheels): the surface
+//!   samples of [`spatter_core::surface_sample`] moved inside, in `layers` layers at (k + ½)·dp behind the
+//!   surface like the lattice layers of a block, each particle with volume (sample area)·dp. The fluid
+//!   then rests half a spacing off the surface, as at lattice walls, so that the fluid particles' volumes
+//!   tile the space up to the body (loads and wetting refer to the true surface).
+//! * **Shell mesh parts** (open surfaces: plates, panels, thin shells with water on both sides): one layer
+//!   on the surface, optional further layers offset by dp against the normal, each particle with the
+//!   Akinci et al. (2012) volume `V_b = 1 / Σ_k W_bk` (same-part neighbours), so that irregular or thin
+//!   samplings still fill the kernel support. A one-layer shell holds the fluid about 1.2–1.6 dp off
+//!   its surface.
 //!
 //! Wall pressure, velocity and density are extrapolated from the fluid every step (Adami, Hu & Adams
 //! 2012, J. Comput. Phys. 231:7057), see [`crate::pass`]. Every part also keeps its surface as triangles
@@ -38,9 +44,31 @@ pub enum Slip {
 pub enum Sampling {
     /// Lattice layers of an analytic box.
     Lattice,
-    /// Surface samples of a mesh, with the coverage of every triangle by the first-layer samples
-    /// (sample indices relative to the part's first particle).
+    /// Surface samples of an open mesh (a shell), with the coverage of every triangle by the first-layer
+    /// samples (sample indices relative to the part's first particle).
     Mesh(TriangleCoverage),
+    /// Samples of a closed mesh moved inside the solid (first layer dp/2 behind the surface), with the
+    /// coverage of every triangle by the first-layer samples.
+    Solid(TriangleCoverage),
+}
+
+impl Sampling {
+    /// Triangle coverage of a mesh part (shell or solid).
+    pub fn coverage(&self) -> Option<&TriangleCoverage> {
+        match self {
+            Sampling::Lattice => None,
+            Sampling::Mesh(c) | Sampling::Solid(c) => Some(c),
+        }
+    }
+
+    /// Distance \[m\] from a first-layer particle to the surface point it stands for, along its normal:
+    /// dp/2 for lattice and solid parts (first layer behind the surface), 0 for shells (on it).
+    pub fn surface_offset(&self, dp: f64) -> f64 {
+        match self {
+            Sampling::Lattice | Sampling::Solid(_) => 0.5 * dp,
+            Sampling::Mesh(_) => 0.0,
+        }
+    }
 }
 
 /// A rigid wall or body.
@@ -144,6 +172,9 @@ pub struct Samples {
     pub normal: Vec<Vec3>,
     /// Wall area the particle stands for \[m², or m per metre of depth in 2D\]; 0 behind the first layer.
     pub area: Vec<f64>,
+    /// Particle volumes \[m³\] when the sampling fixes them (solid mesh parts); empty otherwise (computed
+    /// by [`Boundary::compute_volumes`]).
+    pub volume: Vec<f64>,
 }
 
 /// Face flags of a box in the order −x, +x, −y, +y, −z, +z.
@@ -302,15 +333,53 @@ pub fn box_surface(b: Aabb, faces: Faces, inward: bool, dim: Dim) -> TriMesh {
     TriMesh::from_triangle_soup(&soup)
 }
 
-/// Samples a mesh surface: one layer on it and `layers − 1` more offset by k·dp against the normals.
+/// Samples an open mesh surface (a shell): one layer on it and `layers − 1` more offset by k·dp against
+/// the normals.
 pub fn mesh_samples(mesh: &TriMesh, dp: f64, layers: usize, seed: u64) -> (Samples, TriangleCoverage) {
     let ss = sample_surface(mesh, dp, seed);
-    let mut s = Samples { pos: ss.points.clone(), normal: ss.normals.clone(), area: ss.areas.clone() };
+    let mut s = Samples {
+        pos: ss.points.clone(),
+        normal: ss.normals.clone(),
+        area: ss.areas.clone(),
+        volume: vec![],
+    };
     for k in 1..layers.max(1) {
         for i in 0..ss.points.len() {
             s.pos.push(ss.points[i] - ss.normals[i] * (k as f64 * dp));
             s.normal.push(ss.normals[i]);
             s.area.push(0.0);
+        }
+    }
+    (s, ss.coverage)
+}
+
+/// Samples the solid enclosed by a closed mesh: the surface samples moved inside along the outward
+/// normals, in `layers` layers at depths (k + ½)·dp, each particle with volume (sample area)·dp and the
+/// outward normal (into the fluid). The mesh may be oriented either way (the sign of its enclosed volume
+/// tells). A sample of a deeper layer is kept only inside the solid and no nearer to another part of the
+/// surface than half a spacing less than its depth: where faces meet at an edge, or the solid is thinner
+/// than the layers, the nearest face's samples fill the space and no particle ends up outside.
+pub fn solid_samples(mesh: &TriMesh, dp: f64, layers: usize, seed: u64) -> (Samples, TriangleCoverage) {
+    let ss = sample_surface(mesh, dp, seed);
+    let outward = if mesh.signed_volume() < 0.0 { -1.0 } else { 1.0 };
+    let bvh = TriBvh::build(mesh);
+    let mut s = Samples::default();
+    for k in 0..layers.max(1) {
+        let depth = (k as f64 + 0.5) * dp;
+        for i in 0..ss.points.len() {
+            let n = ss.normals[i] * outward;
+            let p = ss.points[i] - n * depth;
+            if k > 0 {
+                let inside = bvh.contains_point(mesh, p);
+                let crowded = bvh.closest_point(mesh, p, depth - 0.5 * dp).is_some();
+                if !inside || crowded {
+                    continue;
+                }
+            }
+            s.pos.push(p);
+            s.normal.push(n);
+            s.area.push(if k == 0 { ss.areas[i] } else { 0.0 });
+            s.volume.push(ss.areas[i] * dp);
         }
     }
     (s, ss.coverage)
@@ -366,7 +435,11 @@ impl Boundary {
         self.ref_pos.extend(&samples.pos);
         self.ref_normal.extend(&samples.normal);
         self.area.extend(&samples.area);
-        self.volume.extend(std::iter::repeat_n(0.0, n));
+        if samples.volume.len() == n {
+            self.volume.extend(&samples.volume);
+        } else {
+            self.volume.extend(std::iter::repeat_n(0.0, n));
+        }
         self.part.extend(std::iter::repeat_n(idx as u16, n));
         self.wet.extend(std::iter::repeat_n(false, n));
         self.wet_time.extend(std::iter::repeat_n(0.0, n));
@@ -388,13 +461,15 @@ impl Boundary {
         idx
     }
 
-    /// Particle volumes: dp^d for lattice parts, Akinci et al. (2012) `1/Σ_k W_bk` for mesh parts.
+    /// Particle volumes: dp^d for lattice parts, Akinci et al. (2012) `1/Σ_k W_bk` for shell mesh parts;
+    /// solid mesh parts keep the volumes their sampling gave.
     pub fn compute_volumes(&mut self, kernel: &Kernel, dp: f64) {
         let v_lattice = dp.powi(kernel.dim.count());
         for p in &self.parts {
             let r = p.start..p.end;
             match p.sampling {
                 Sampling::Lattice => self.volume[r].iter_mut().for_each(|v| *v = v_lattice),
+                Sampling::Solid(_) => {}
                 Sampling::Mesh(_) => {
                     let pts = &self.ref_pos[r.clone()];
                     let mut g = NeighbourGrid::new();

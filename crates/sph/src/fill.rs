@@ -64,8 +64,10 @@ impl<'a> Admission<'a> {
             return false;
         }
         for part in &self.boundary.parts {
-            let mesh_part = matches!(part.sampling, crate::boundary::Sampling::Mesh(_));
-            if mesh_part && part.bvh.closest_point(&part.surface, p, self.clear.surface).is_some() {
+            // A site exactly `surface` off a face (lattice-aligned bodies) is admitted whatever the rounding.
+            let near = self.clear.surface * (1.0 - 1e-9);
+            if part.sampling.coverage().is_some() && part.bvh.closest_point(&part.surface, p, near).is_some()
+            {
                 return false;
             }
             if part.closed && part.bvh.bounds().contains(p) && part.bvh.contains_point(&part.surface, p) {

@@ -17,7 +17,8 @@
 //! corrector → next time step.
 
 use crate::boundary::{
-    block_lattice, box_surface, mesh_samples, tank_lattice, Boundary, Faces, Frame, Sampling, Slip,
+    block_lattice, box_surface, mesh_samples, solid_samples, tank_lattice, Boundary, Faces, Frame, Sampling,
+    Slip,
 };
 use crate::error::SphError;
 use crate::fill::{fill_box, flood_fill, Clearance};
@@ -249,13 +250,15 @@ impl Simulation {
         k
     }
 
-    /// A triangle-mesh wall or body (3D only), sampled at the spacing: one layer on the surface plus
-    /// `layers − 1` behind it (against the normals).
+    /// A triangle-mesh wall or body (3D only), sampled at the spacing. A closed mesh is a solid: `layers`
+    /// layers inside it, the first dp/2 behind the surface (default: [`Self::default_layers`], enough to
+    /// fill the kernel support). An open mesh is a shell: one layer on the surface plus `layers − 1`
+    /// behind it against the normals (default 1).
     pub fn add_mesh(
         &mut self,
         name: &str,
         mesh: TriMesh,
-        layers: usize,
+        layers: Option<usize>,
         node: Option<usize>,
         w: WallOptions,
     ) -> Result<usize, SphError> {
@@ -266,10 +269,17 @@ impl Simulation {
             return Err(SphError::Setup(format!("mesh part `{name}` has no triangles")));
         }
         let seed = 0x5350_4800 + self.boundary.parts.len() as u64;
-        let (s, cov) = mesh_samples(&mesh, self.params.spacing, layers.max(1), seed);
         let topo = mesh.topology();
         let closed = !topo.edge_use_count.is_empty() && topo.edge_use_count.iter().all(|&c| c == 2);
-        Ok(self.boundary.add_part(name, node, s, mesh, Sampling::Mesh(cov), w.adhesion, w.slip, closed))
+        let dp = self.params.spacing;
+        let (s, sampling) = if closed {
+            let (s, cov) = solid_samples(&mesh, dp, layers.unwrap_or_else(|| self.default_layers()), seed);
+            (s, Sampling::Solid(cov))
+        } else {
+            let (s, cov) = mesh_samples(&mesh, dp, layers.unwrap_or(1), seed);
+            (s, Sampling::Mesh(cov))
+        };
+        Ok(self.boundary.add_part(name, node, s, mesh, sampling, w.adhesion, w.slip, closed))
     }
 
     /// Sets the domain box; particles leaving it are removed and counted.
@@ -438,18 +448,7 @@ impl Simulation {
             eos,
             akinci: crate::kernel::AkinciSplines::new(support),
             wet_d2: p.wet_distance * p.wet_distance,
-            wet_offset: self
-                .boundary
-                .parts
-                .iter()
-                .map(|q| {
-                    if matches!(q.sampling, crate::boundary::Sampling::Lattice) {
-                        0.5 * p.spacing
-                    } else {
-                        0.0
-                    }
-                })
-                .collect(),
+            wet_offset: self.boundary.parts.iter().map(|q| q.sampling.surface_offset(p.spacing)).collect(),
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }
     }

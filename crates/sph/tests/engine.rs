@@ -26,7 +26,7 @@ fn a_moving_thin_shell_loses_no_particle() {
     plate.map_vertices(|v| Vec3::new(0.1, v.x - 0.02, v.y - 0.02));
     let table = MotionTable::parse("0 1 0 0 0 0 0\n1 1 0 0 0 0 0\n", Vec3::new(0.1, 0.05, 0.15)).unwrap();
     let node = sim.add_motion(Motion::Tabulated(table), None);
-    sim.add_mesh("plate", plate, 1, Some(node), WallOptions::default()).unwrap();
+    sim.add_mesh("plate", plate, Some(1), Some(node), WallOptions::default()).unwrap();
     let n0 = sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(0.4, 0.1, 0.15)), Vec3::ZERO, true);
     assert!(n0 > 2000);
     sim.initialize().unwrap();
@@ -61,7 +61,7 @@ fn wet_area_does_not_depend_on_the_mesh() {
         let mut sim = Simulation::new(p);
         let mut plate = TriMesh::rectangle(0.4, 0.4, 0.0, nx, ny);
         plate.map_vertices(|v| v - Vec3::new(0.2, 0.2, 0.0));
-        sim.add_mesh("plate", plate, 1, None, WallOptions::default()).unwrap();
+        sim.add_mesh("plate", plate, Some(1), None, WallOptions::default()).unwrap();
         // A one-layer disc of water of radius 0.1 m, 0.6 dp above the plate.
         let mut pts = Vec::new();
         for j in -12..12 {

@@ -129,7 +129,7 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
                     .as_deref()
                     .ok_or_else(|| SphError::Setup(format!("{} is missing", key("file"))))?;
                 let mesh = TriMesh::load(&resolve(base, file), w.scale)?;
-                sim.add_mesh(&w.name, mesh, w.layers.unwrap_or(1), node, opts)?;
+                sim.add_mesh(&w.name, mesh, w.layers, node, opts)?;
             }
             WallType::Cylinder => {
                 let r = w.radius_m.unwrap_or(1.0);
@@ -144,7 +144,7 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
                     w.segments,
                     rings,
                 );
-                sim.add_mesh(&w.name, mesh, w.layers.unwrap_or(1), node, opts)?;
+                sim.add_mesh(&w.name, mesh, w.layers, node, opts)?;
             }
         }
     }

@@ -230,7 +230,8 @@ pub struct WallConfig {
     /// Tank faces left open, among "-x", "+x", "-y", "+y", "-z", "+z" (default: "+z").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub open_faces: Option<Vec<String>>,
-    /// Particle layers: default ⌈2h/dp⌉ for tanks and blocks, 1 for meshes and cylinders.
+    /// Particle layers: default ⌈2h/dp⌉ for tanks, blocks, closed meshes and cylinders (solids), 1 for
+    /// open meshes (shells).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub layers: Option<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

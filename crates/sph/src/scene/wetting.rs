@@ -57,7 +57,7 @@ pub fn wetting_map(sim: &Simulation, k: usize, elapsed: f64) -> WettingMap {
     let frame = b.frames[k];
     let t = elapsed.max(f64::MIN_POSITIVE);
     match &part.sampling {
-        Sampling::Mesh(cov) => {
+        Sampling::Mesh(cov) | Sampling::Solid(cov) => {
             let n = part.end - part.start;
             let now: Vec<f64> = (0..n).map(|s| if b.wet[part.start + s] { 1.0 } else { 0.0 }).collect();
             let frac: Vec<f64> = (0..n).map(|s| (b.wet_time[part.start + s] / t).min(1.0)).collect();
@@ -109,7 +109,7 @@ pub fn particle_map(sim: &Simulation, k: usize, elapsed: f64) -> (TriMesh, Vec<f
     let b = &sim.boundary;
     let dp = sim.params.spacing;
     let t = elapsed.max(f64::MIN_POSITIVE);
-    let lattice = matches!(part.sampling, Sampling::Lattice);
+    let offset = part.sampling.surface_offset(dp);
     let mut soup = Vec::new();
     let mut frac = Vec::new();
     for i in part.start..part.end {
@@ -118,8 +118,8 @@ pub fn particle_map(sim: &Simulation, k: usize, elapsed: f64) -> (TriMesh, Vec<f
             continue;
         }
         let n = b.normal(i);
-        // Lattice particles sit dp/2 behind the face they stand for; mesh samples lie on the surface.
-        let c = if lattice { b.position(i) + n * (0.5 * dp) } else { b.position(i) };
+        // Lattice and solid particles sit dp/2 behind the face they stand for; shell samples lie on it.
+        let c = b.position(i) + n * offset;
         let side = if sim.params.dim == crate::kernel::Dim::Two { dp } else { a.sqrt() };
         let (u, v) = orthonormal_basis(n);
         let (u, v) = (u * (0.5 * side), v * (0.5 * side));
