@@ -288,7 +288,7 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
                  deposits up to t = {:.6} s; `--resume` continues the run and replaces them at its end",
                 tr.state.time
             );
-            tracing::info!("{note}");
+            // The summary lines go to the log (and the screen) through the runner.
             s.headline.push(note);
         }
         return Ok(s);
