@@ -8,7 +8,7 @@ use crate::contact::{
     RestitutionDamping,
 };
 use crate::error::DemError;
-use crate::insertion::{Injector, Region};
+use crate::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
 use crate::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
 use crate::sim::{SimState, Simulation};
 use crate::timestep;
@@ -25,8 +25,8 @@ use spatter_io::run::{RunContext, RunSummary};
 struct Checkpoint<S> {
     scene_hash: u64,
     sim: SimState<S>,
-    /// Particles inserted and random generator of each injector.
-    injectors: Vec<(u64, spatter_core::rng::Rng)>,
+    /// State of each injector (particles and mass placed, pending draw, random generator).
+    injectors: Vec<InjectorState>,
     output_index: u64,
     csv_bytes: u64,
     warnings: Vec<String>,
@@ -197,9 +197,8 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
         if ck.injectors.len() != injectors.len() {
             return Err(DemError::Resume("the number of injectors changed".into()));
         }
-        for (slot, (inserted, rng)) in injectors.iter_mut().zip(ck.injectors) {
-            slot.0.inserted = inserted;
-            slot.0.rng = rng;
+        for (slot, state) in injectors.iter_mut().zip(ck.injectors) {
+            slot.0.state = state;
         }
         let t = sim.time();
         let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
@@ -224,16 +223,8 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
         warnings = ck.warnings;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
-        for p in setup::initial_particles(cfg)? {
+        for p in setup::initial_particles(cfg, &sim.walls)? {
             sim.add_particle(p);
-        }
-        for f in &cfg.fill {
-            if let Some(n) = f.count {
-                let got = sim.particles.len();
-                if (got as u64) < n {
-                    tracing::warn!("a fill placed fewer particles than requested ({got} so far of {n})");
-                }
-            }
         }
         warnings = time_step_warnings(cfg, &sim);
         for w in &warnings {
@@ -257,7 +248,7 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
             let ck = Checkpoint {
                 scene_hash: hash,
                 sim: sim.state(),
-                injectors: injectors.iter().map(|(i, _)| (i.inserted, i.rng.clone())).collect(),
+                injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
                 output_index: out.index,
                 csv_bytes: out.csv.bytes_written(),
                 warnings: warnings.clone(),
@@ -274,7 +265,7 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
         let step = sim.step_count();
         for (k, (inj, region)) in injectors.iter_mut().enumerate() {
             if step % inject_every[k] == 0 {
-                inject(&mut sim, inj, region);
+                inject(&mut sim, inj, region, k);
             }
         }
         if (step + 1) % out_every == 0 || step + 1 == total_steps {
@@ -290,20 +281,30 @@ fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Resul
     }
     out.csv.flush().map_err(io(&csv_path))?;
     let _ = std::fs::remove_file(dir.checkpoint_path());
-    Ok(summary(cfg, &sim, &warnings, ctx))
+    Ok(summary(cfg, &sim, &injectors, &warnings, ctx))
 }
 
-/// Places the particles an injector owes at the current time.
-fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region) {
-    let due = inj.due(sim.time());
-    if due == 0 {
+/// Places the particles injector `k` owes at the current time, clear of the particles present and of the
+/// walls where they are now.
+fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
+    let t = sim.time();
+    if inj.due(t) == 0 && inj.state.pending.is_some() {
         return;
     }
-    let reach = region.bounds().inflated(4.0 * sim.particles.radius.iter().copied().fold(0.0, f64::max));
+    let reach = region.bounds().inflated(sim.particles.radius.iter().copied().fold(0.0, f64::max));
     let p = &sim.particles;
     let existing: Vec<_> =
         (0..p.len()).filter(|&i| reach.contains(p.pos[i])).map(|i| (p.pos[i], p.radius[i])).collect();
-    let placed = inj.place(region, due, &existing);
+    let postponed = inj.state.postponed;
+    let placed = inj.place(region, t, &existing, &WallClearance::new(&sim.walls, t));
+    if postponed == 0 && inj.state.postponed > 0 {
+        tracing::warn!(
+            "inject[{k}]: at t = {t:.6} s the region had no room for the next particle (diameter {:e} m) \
+             in {} random positions; it waits for the next placement (the run summary gives the total)",
+            inj.state.pending.unwrap_or(0.0),
+            inj.attempts
+        );
+    }
     for (x, r) in placed {
         let mut np = crate::particles::NewParticle::at(x, r, inj.material);
         np.vel = inj.velocity;
@@ -369,6 +370,7 @@ fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> 
 fn summary<L: ContactLaw>(
     cfg: &SceneConfig,
     sim: &Simulation<L>,
+    injectors: &[(Injector, Region)],
     warnings: &[String],
     ctx: &RunContext,
 ) -> RunSummary {
@@ -399,6 +401,23 @@ fn summary<L: ContactLaw>(
         100.0 * cfg.dt_s / sim.rayleigh_time(),
         sim.bytes_per_particle()
     ));
+    for (k, (inj, _)) in injectors.iter().enumerate() {
+        let t = sim.time();
+        let target = match inj.rate {
+            InjectionRate::ParticlesPerSecond(_) => format!("{:.0} particles", inj.target(t)),
+            InjectionRate::KgPerSecond(_) => format!("{:.6e} kg", inj.target(t)),
+        };
+        s.headline.push(format!(
+            "inject[{k}]: {} particles, {:.6e} kg placed (target {target})",
+            inj.state.inserted, inj.state.mass
+        ));
+        if inj.state.postponed > 0 {
+            s.headline.push(format!(
+                "warning: inject[{k}]: the region was full at {} placement times; particles waited for room",
+                inj.state.postponed
+            ));
+        }
+    }
     for w in warnings {
         s.headline.push(format!("warning: {w}"));
     }

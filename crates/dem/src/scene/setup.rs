@@ -4,7 +4,10 @@
 use super::config::*;
 use crate::contact::{PairProps, PairTable};
 use crate::error::DemError;
-use crate::insertion::{lattice_fill, random_fill, FillTarget, InjectionRate, Injector, Region};
+use crate::insertion::{
+    lattice_fill, random_fill, FillTarget, InjectionRate, Injector, InjectorState, OverlapIndex, Region,
+    WallClearance,
+};
 use crate::particles::NewParticle;
 use crate::walls::{Cylinder, MeshWall, Plane, Rectangle, Wall, WallShape};
 use spatter_core::distribution::SizeDistribution;
@@ -14,16 +17,7 @@ use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::rng::{seeded, Rng};
 use spatter_core::{Aabb, Vec3};
 
-/// Largest diameter a distribution can produce, if bounded.
-pub fn max_diameter(d: &SizeDistribution) -> Option<f64> {
-    match d {
-        SizeDistribution::Mono { diameter } => Some(*diameter),
-        SizeDistribution::Uniform { max, .. } => Some(*max),
-        SizeDistribution::Normal { mean, std_dev } => Some(mean + 3.0 * std_dev),
-        SizeDistribution::LogNormal { .. } => None,
-        SizeDistribution::Tabulated { diameters, .. } => diameters.last().copied(),
-    }
-}
+pub use crate::insertion::max_diameter;
 
 /// Smallest diameter a distribution can produce (a lower bound for the time-step check).
 pub fn min_diameter(d: &SizeDistribution) -> f64 {
@@ -145,8 +139,18 @@ pub fn region(cfg: &SceneConfig, r: &RegionConfig) -> Result<Region, DemError> {
     })
 }
 
-/// The particles of the `fill` entries, in order, avoiding each other.
-pub fn initial_particles(cfg: &SceneConfig) -> Result<Vec<NewParticle>, DemError> {
+/// Consecutive draws above the lattice spacing after which a lattice fill gives up.
+const LATTICE_REDRAWS: u32 = 10_000;
+
+/// The particles of the `fill` entries, in order, avoiding each other and `walls` (placed as at t = 0).
+///
+/// A random fill that cannot reach its `count` or `volume_fraction` (a drawn sphere found no free place
+/// in `max_attempts` random positions) is an error naming the key, with the number placed: running with
+/// fewer particles than asked for would be a different experiment. A lattice fill takes the sites that
+/// are inside the region and clear of walls and earlier fills; diameters larger than the spacing are
+/// redrawn (the lattice truncates the distribution there, and says so in the log).
+pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewParticle>, DemError> {
+    let clear = WallClearance::new(walls, 0.0);
     let mut placed: Vec<(Vec3, f64)> = Vec::new();
     let mut out = Vec::new();
     for (i, f) in cfg.fill.iter().enumerate() {
@@ -155,33 +159,90 @@ pub fn initial_particles(cfg: &SceneConfig) -> Result<Vec<NewParticle>, DemError
         let mut rng: Rng = seeded(cfg.seed, 1000 + i as u64);
         let spheres: Vec<(Vec3, f64)> = match f.method {
             FillMethod::Random => {
-                let target = match (f.count, f.volume_fraction) {
-                    (Some(n), _) => FillTarget::Count(n),
-                    (None, Some(v)) => FillTarget::VolumeFraction(v),
-                    (None, None) => FillTarget::Count(0),
+                let (target, key) = match (f.count, f.volume_fraction) {
+                    (Some(n), _) => (FillTarget::Count(n), "count"),
+                    (None, Some(v)) => (FillTarget::VolumeFraction(v), "volume_fraction"),
+                    (None, None) => (FillTarget::Count(0), "count"),
                 };
-                random_fill(&reg, &f.size, target, &placed, f.max_attempts, &mut rng)
+                let got = random_fill(&reg, &f.size, target, &placed, &clear, f.max_attempts, &mut rng);
+                if let Some(d) = got.stuck_at {
+                    let reached = match target {
+                        FillTarget::Count(n) => format!("placed {} of {n} particles", got.spheres.len()),
+                        FillTarget::VolumeFraction(v) => format!(
+                            "reached a solid fraction of {:.4} of the requested {v} ({} particles)",
+                            got.solid / reg.volume(),
+                            got.spheres.len()
+                        ),
+                    };
+                    return Err(DemError::Config {
+                        key: format!("fill[{i}].{key}"),
+                        message: format!(
+                            "the region is full: {reached}; the next sphere (diameter {d:e} m) found no place \
+                             inside the region, clear of walls and of earlier particles, in max_attempts = {} \
+                             random positions. Enlarge the region, ask for fewer particles, or raise \
+                             max_attempts (random sequential addition of equal spheres jams near a solid \
+                             fraction of 0.38; use method = \"lattice\" for denser packings)",
+                            f.max_attempts
+                        ),
+                    });
+                }
+                got.spheres
             }
             FillMethod::Lattice => {
                 let d_max = max_diameter(&f.size);
                 let spacing = f.spacing_m.or(d_max.map(|d| 1.01 * d)).unwrap_or(0.0);
                 let r_site = 0.5 * spacing;
                 let sites = lattice_fill(&reg, spacing, r_site, f.lattice);
-                let mut v = Vec::with_capacity(sites.len());
-                for x in sites {
-                    // Redraw diameters larger than the spacing (unbounded distributions).
-                    let mut d = f.size.sample(&mut rng);
-                    for _ in 0..100 {
-                        if d <= spacing {
-                            break;
-                        }
-                        d = f.size.sample(&mut rng);
-                    }
-                    let r = 0.5 * d.min(spacing);
-                    if placed.iter().all(|(y, ry)| (*y - x).length() >= r + ry) {
-                        v.push((x, r));
+                let mut index =
+                    OverlapIndex::new(spacing.max(2.0 * placed.iter().map(|p| p.1).fold(0.0, f64::max)));
+                let b = reg.bounds().inflated(placed.iter().map(|p| p.1).fold(0.0, f64::max));
+                for &(x, r) in &placed {
+                    if b.contains(x) {
+                        index.insert(x, r);
                     }
                 }
+                let mut v = Vec::with_capacity(sites.len());
+                let mut pending: Option<f64> = None;
+                let mut redraws = 0u64;
+                for x in sites {
+                    // The next diameter not above the spacing; a site that cannot take it passes it on.
+                    let d = match pending {
+                        Some(d) => d,
+                        None => {
+                            let mut d = f.size.sample(&mut rng);
+                            let mut k = 0;
+                            while d > spacing {
+                                k += 1;
+                                if k > LATTICE_REDRAWS {
+                                    return Err(DemError::Config {
+                                        key: format!("fill[{i}].spacing_m"),
+                                        message: format!(
+                                            "spacing_m = {spacing} m is below nearly every diameter of the \
+                                             size distribution ({LATTICE_REDRAWS} draws in a row were larger)"
+                                        ),
+                                    });
+                                }
+                                d = f.size.sample(&mut rng);
+                            }
+                            redraws += k as u64;
+                            d
+                        }
+                    };
+                    let r = 0.5 * d;
+                    if clear.overlapping(x, r).is_some() || index.overlaps(x, r) {
+                        pending = Some(d);
+                        continue;
+                    }
+                    pending = None;
+                    v.push((x, r));
+                }
+                if redraws > 0 {
+                    tracing::warn!(
+                        "fill[{i}]: {redraws} diameters above spacing_m = {spacing} m were redrawn (a lattice \
+                         fill truncates the size distribution at its spacing)"
+                    );
+                }
+                tracing::info!("fill[{i}]: {} particles on the lattice", v.len());
                 v
             }
         };
@@ -201,22 +262,21 @@ pub fn injectors(cfg: &SceneConfig) -> Result<Vec<(Injector, Region)>, DemError>
     let mut out = Vec::new();
     for (i, j) in cfg.inject.iter().enumerate() {
         let material = material_index(cfg, &j.material, &format!("inject[{i}].material"))?;
-        let rho = cfg.materials[&j.material].density;
         let rate = match (j.particles_per_s, j.kg_per_s) {
             (Some(n), _) => InjectionRate::ParticlesPerSecond(n),
             (None, Some(m)) => InjectionRate::KgPerSecond(m),
             (None, None) => InjectionRate::ParticlesPerSecond(0.0),
         };
         let inj = Injector {
-            number_rate: Injector::number_rate(rate, &j.size, rho),
             dist: j.size.clone(),
+            rate,
+            density: cfg.materials[&j.material].density,
             start: j.start_s,
             end: j.end_s.unwrap_or(f64::INFINITY),
             velocity: j.velocity_m_s,
             material,
             attempts: j.attempts,
-            inserted: 0,
-            rng: seeded(cfg.seed, 2000 + i as u64),
+            state: InjectorState::new(seeded(cfg.seed, 2000 + i as u64)),
         };
         out.push((inj, region(cfg, &j.region)?));
     }

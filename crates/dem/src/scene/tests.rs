@@ -200,3 +200,127 @@ fn tangential_history_rule_is_selectable_from_the_scene() {
     }
     assert_ne!(csv[0], csv[1], "the tangential rule changed nothing");
 }
+
+/// The mixed scene of the insertion audit: a tube, a post standing through the fill and injection
+/// regions, a horizontal mesh plate across the fill region, a rotating paddle; a random log-normal fill,
+/// a lattice fill and a mass-rate injector.
+fn walls_in_the_way_toml(dir: &Path) -> String {
+    let plate = dir.join("plate.obj");
+    std::fs::write(
+        &plate,
+        "v -0.05 -0.05 0.125\nv 0.05 -0.05 0.125\nv 0.05 0.05 0.125\nv -0.05 0.05 0.125\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    format!(
+        r#"
+dt_s = 4e-6
+duration_s = 0.004
+output_interval_s = 0.002
+
+[materials.grain]
+youngs_modulus_pa = 5e7
+poisson_ratio = 0.3
+density_kg_m3 = 2500
+
+[pair_defaults]
+friction = 0.4
+restitution = 0.5
+
+[[walls]]
+name = "tube"
+material = "grain"
+shape = {{ type = "cylinder", point_m = [0, 0, 0], axis = [0, 0, 1], radius_m = 0.08, inside = true }}
+
+[[walls]]
+name = "post"
+material = "grain"
+shape = {{ type = "cylinder", point_m = [0, 0, 0], axis = [0, 0, 1], radius_m = 0.01, inside = false, axial_min_m = 0.0, axial_max_m = 0.2 }}
+
+[[walls]]
+name = "paddle"
+material = "grain"
+shape = {{ type = "rectangle", center_m = [0.04, 0, 0.06], half_u_m = [0.02, 0, 0], half_v_m = [0, 0.01, 0] }}
+motion = {{ type = "rotation", center_m = [0, 0, 0.06], axis = [0, 0, 1], angular_speed_rad_s = 5 }}
+
+[[walls]]
+name = "plate"
+material = "grain"
+shape = {{ type = "mesh", file = "{}" }}
+
+[[fill]]
+material = "grain"
+region = {{ type = "cylinder", base_m = [0, 0, 0.1], axis = [0, 0, 1], radius_m = 0.07, height_m = 0.05 }}
+size = {{ kind = "log_normal", median = 0.004, geometric_std = 1.3 }}
+count = 200
+
+[[fill]]
+material = "grain"
+method = "lattice"
+region = {{ type = "box", min_m = [-0.03, -0.03, 0.155], max_m = [0.03, 0.03, 0.17] }}
+size = {{ kind = "mono", diameter = 0.004 }}
+
+[[inject]]
+material = "grain"
+region = {{ type = "box", min_m = [-0.04, -0.04, 0.17], max_m = [0.04, 0.04, 0.2] }}
+size = {{ kind = "tabulated", diameters = [0.003, 0.004, 0.006], cumulative = [0, 0.5, 1], basis = "mass" }}
+kg_per_s = 0.05
+velocity_m_s = [0, 0, -0.5]
+"#,
+        plate.display()
+    )
+}
+
+#[test]
+fn fills_and_injections_cut_by_walls_create_no_overlaps_and_run() {
+    // Before, the random fill put spheres into the post and the run stopped at step 0 ("overlap with a
+    // wall is 5.792 of its radius"). Every initial sphere must now keep its radius from the post's
+    // surface (r ≥ 0.01 + radius within its axial range) and from the plate (|z − 0.125| ≥ radius over
+    // the plate's square), exact geometry to 1e-12 m, and the run must complete.
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = parse(&walls_in_the_way_toml(tmp.path()));
+    Checker::run(&cfg, None).unwrap();
+    let built = setup::build(&cfg).unwrap();
+    let ps = setup::initial_particles(&cfg, &built.walls).unwrap();
+    let lattice = ps.len() - 200;
+    assert!(lattice > 20, "{lattice} lattice particles");
+    let clear_of_walls = |x: spatter_core::Vec3, r: f64| {
+        let post = x.truncate().length() - 0.01;
+        let on_plate = x.x.abs() <= 0.05 && x.y.abs() <= 0.05;
+        let plate = if on_plate { (x.z - 0.125).abs() } else { f64::INFINITY };
+        let tube = 0.08 - x.truncate().length();
+        post >= r - 1e-12 && plate >= r - 1e-12 && tube >= r - 1e-12
+    };
+    for p in &ps {
+        assert!(clear_of_walls(p.pos, p.radius), "{:?} r = {}", p.pos, p.radius);
+    }
+    // Some spheres sit right next to the post and the plate (the walls did cut the regions).
+    assert!(ps.iter().any(|p| p.pos.truncate().length() < 0.01 + 2.0 * p.radius));
+    assert!(ps.iter().any(|p| (p.pos.z - 0.125).abs() < 2.0 * p.radius));
+    let dir = RunDir::create(&tmp.path().join("run")).unwrap();
+    let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false })
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.finished, Finished::Completed);
+    // 0.05 kg/s for 4 ms: 2e-4 kg, within half a particle (≤ 2.83e-7 kg for 6 mm) of the target.
+    let line = s.headline.iter().find(|l| l.starts_with("inject[0]")).expect("injector line");
+    let placed: f64 = line.split(", ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!((placed - 2e-4).abs() <= 0.5 * 2500.0 * std::f64::consts::PI / 6.0 * 0.006f64.powi(3), "{line}");
+}
+
+#[test]
+fn a_fill_that_does_not_fit_is_an_error_naming_the_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cfg = parse(&walls_in_the_way_toml(tmp.path()));
+    cfg.fill[0].count = Some(20_000);
+    cfg.fill[0].max_attempts = 2000;
+    let built = setup::build(&cfg).unwrap();
+    let err = setup::initial_particles(&cfg, &built.walls).unwrap_err().to_string();
+    assert!(err.starts_with("fill[0].count: the region is full: placed "), "{err}");
+    assert!(err.contains("of 20000 particles") && err.contains("max_attempts = 2000"), "{err}");
+    cfg.fill[0].count = None;
+    cfg.fill[0].volume_fraction = Some(0.6);
+    let err = setup::initial_particles(&cfg, &built.walls).unwrap_err().to_string();
+    assert!(
+        err.starts_with("fill[0].volume_fraction: the region is full: reached a solid fraction"),
+        "{err}"
+    );
+}

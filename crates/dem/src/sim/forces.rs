@@ -484,31 +484,72 @@ impl<L: ContactLaw> Simulation<L> {
         let (a, b) = self.last_worst;
         let ratio = self.st.last.max_overlap_ratio;
         let what = if b == u32::MAX {
-            format!("overlap with a wall is {:.3} of its radius", ratio)
+            match self.deepest_wall(a) {
+                Some(name) => format!("overlap with wall `{name}` is {ratio:.3} of its radius"),
+                None => format!("overlap with a wall is {ratio:.3} of its radius"),
+            }
         } else {
-            format!("overlap with particle id {b} is {:.3} of the smaller radius", ratio)
+            format!("overlap with particle id {b} is {ratio:.3} of the smaller radius")
         };
         DemError::BlowUp {
             particle: a,
             step: self.st.step,
             time_s: self.st.time,
             what: format!("{what} (limit {})", self.settings.max_overlap_fraction),
-            cause: self.likely_cause(),
+            cause: self.likely_cause(true),
         }
     }
 
-    /// A sentence on what most likely went wrong.
-    pub(crate) fn likely_cause(&self) -> String {
+    /// Name of the wall that particle `id` overlaps most (diagnostics only).
+    fn deepest_wall(&self, id: u32) -> Option<&str> {
+        let i = self.particles.index_of(id)?;
+        let (x, r) = (self.particles.pos[i], self.particles.radius[i]);
+        let t = self.st.time;
+        let mut best: Option<(f64, usize)> = None;
+        for (w, wall) in self.walls.iter().enumerate() {
+            let kin = WallKinematics::of(&wall.motion, t);
+            if let Some(d) = wall.surface_distance(&kin, x, r) {
+                if best.is_none_or(|(bd, _)| d < bd) {
+                    best = Some((d, w));
+                }
+            }
+        }
+        best.map(|(_, w)| self.walls[w].name.as_str())
+    }
+
+    /// A sentence on what most likely went wrong; `overlap` for an overlap blow-up (the worst contact of
+    /// the last evaluation is the culprit), false for a non-finite state.
+    pub(crate) fn likely_cause(&self, overlap: bool) -> String {
         let tr = self.rayleigh_time();
-        if self.dt > 0.3 * tr {
+        let dt_note = (self.dt > 0.3 * tr).then(|| {
             format!(
                 "the time step dt = {:e} s is {:.2} of the Rayleigh time {:e} s; use dt ≤ 0.2 × Rayleigh time",
                 self.dt,
                 self.dt / tr,
                 tr
             )
-        } else if self.st.step < 5 {
-            "particles were created overlapping (check insertion regions, lattice spacing and radii)".into()
+        });
+        // A particle that no force evaluation had seen before this one cannot have been pushed that deep
+        // by the time step: it was created overlapping.
+        let (a, b) = self.last_worst;
+        let new = |id: u32| id != u32::MAX && id >= self.evaluated_ids;
+        if overlap && (new(a) || new(b)) {
+            let partner = if b == u32::MAX {
+                self.deepest_wall(a).map_or("a wall".to_string(), |n| format!("wall `{n}`"))
+            } else {
+                format!("particle id {}", if new(a) { b } else { a })
+            };
+            let id = if new(a) { a } else { b };
+            let mut s = format!(
+                "particle id {id} was created overlapping {partner} (this was its first force evaluation, so                  the time step is not the cause); check where particles are added (fill and inject regions                  against walls and other particles, lattice spacing, radii)"
+            );
+            if let Some(d) = dt_note {
+                s.push_str(&format!("; separately, {d}"));
+            }
+            return s;
+        }
+        if let Some(d) = dt_note {
+            d
         } else {
             "an impact too fast or a material too soft for this time step (reduce dt_s or check speeds, \
              moduli and wall motion)"

@@ -98,7 +98,7 @@ impl<L: ContactLaw> Simulation<L> {
                     p.vel[i].to_array(),
                     p.force[i].to_array()
                 ),
-                cause: self.likely_cause(),
+                cause: self.likely_cause(false),
             }),
         }
     }

@@ -80,8 +80,13 @@ pub enum EnergyMethod {
 pub struct EnergyAccounts {
     /// Work dissipated by dashpots, Coulomb slip and rolling resistance (per-contact bookkeeping only).
     pub dissipated: f64,
-    /// Kinetic + rotational energy of the particles at insertion, minus that of removed particles.
+    /// Kinetic energy of the particles at insertion, minus that of removed particles.
     pub injected_kinetic: f64,
+    /// Rotational energy of the particles at insertion, minus that of removed particles (kept apart
+    /// from the kinetic term so that the residual budget sums exactly like [`Simulation::energy`] and
+    /// reads exactly zero before the first step).
+    #[serde(default)]
+    pub injected_rotational: f64,
     /// Σ m x of the free particles at insertion, minus that of removed particles \[kg m\]; their
     /// potential energy is −g·(Σ m x).
     pub injected_moment: Vec3,
@@ -258,6 +263,10 @@ pub struct Simulation<L: ContactLaw> {
     state_maybe_nonfinite: bool,
     /// The velocities are half-step velocities v(t − Δt/2) (between the kicks of velocity Verlet).
     pub(crate) half_step_velocities: bool,
+    /// Particles with ids below this had been through a force evaluation before the latest one (ids
+    /// are assigned in increasing order); a blow-up at a newer particle's first evaluation means it was
+    /// created overlapping.
+    evaluated_ids: u32,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -290,6 +299,7 @@ impl<L: ContactLaw> Simulation<L> {
             base_forces_ready: false,
             state_maybe_nonfinite: false,
             half_step_velocities: false,
+            evaluated_ids: 0,
         }
     }
 
@@ -350,8 +360,8 @@ impl<L: ContactLaw> Simulation<L> {
             self.particles.force[i] = m * self.gravity;
             let pa = &self.particles;
             let e = &mut self.st.energy;
-            e.injected_kinetic +=
-                0.5 * m * pa.vel[i].length_squared() + 0.5 * pa.inertia(i) * pa.omega[i].length_squared();
+            e.injected_kinetic += 0.5 * m * pa.vel[i].length_squared();
+            e.injected_rotational += 0.5 * pa.inertia(i) * pa.omega[i].length_squared();
             e.injected_moment += m * pa.pos[i];
         }
         id
@@ -394,6 +404,7 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         self.particles = s.particles;
+        self.evaluated_ids = self.particles.next_id();
         self.st = s.dynamic;
         let n = self.st.wall_list.state.len();
         self.st.wall_list.out.clear();
@@ -539,6 +550,7 @@ impl<L: ContactLaw> Simulation<L> {
         if self.st.last.max_overlap_ratio > self.settings.max_overlap_fraction {
             return Err(self.blow_up_overlap());
         }
+        self.evaluated_ids = self.particles.next_id();
         Ok(())
     }
 
@@ -549,7 +561,7 @@ impl<L: ContactLaw> Simulation<L> {
         let p = &self.particles;
         let mut ke = 0.0;
         let mut rot = 0.0;
-        let mut pot = 0.0;
+        let mut moment = Vec3::ZERO;
         for i in 0..p.len() {
             if p.inv_mass[i] == 0.0 {
                 continue;
@@ -557,14 +569,16 @@ impl<L: ContactLaw> Simulation<L> {
             let m = p.mass(i);
             ke += 0.5 * m * p.vel[i].length_squared();
             rot += 0.5 * p.inertia(i) * p.omega[i].length_squared();
-            pot -= m * self.gravity.dot(p.pos[i]);
+            moment += m * p.pos[i];
         }
+        // Summed like the injected accounts, so the residual is exactly zero before the first step.
+        let pot = -self.gravity.dot(moment);
         let a = &self.st.energy;
         let elastic = self.st.last.elastic;
         let dissipated = match self.energy_method {
             EnergyMethod::PerContact => a.dissipated,
             EnergyMethod::Residual => {
-                let e_in = a.injected_kinetic - self.gravity.dot(a.injected_moment);
+                let e_in = a.injected_kinetic + a.injected_rotational - self.gravity.dot(a.injected_moment);
                 e_in + a.external_work + a.wall_work - (ke + rot + pot + elastic)
             }
         };

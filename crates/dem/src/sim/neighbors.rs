@@ -112,8 +112,8 @@ impl<L: ContactLaw> Simulation<L> {
             for (i, &x) in pos.iter().enumerate() {
                 if p.inv_mass[i] > 0.0 && !dom.contains(x) {
                     let m = p.mass(i);
-                    e.injected_kinetic -= 0.5 * m * p.vel[i].length_squared()
-                        + 0.5 * p.inertia(i) * p.omega[i].length_squared();
+                    e.injected_kinetic -= 0.5 * m * p.vel[i].length_squared();
+                    e.injected_rotational -= 0.5 * p.inertia(i) * p.omega[i].length_squared();
                     e.injected_moment -= m * (x - back * p.vel[i]);
                 }
             }

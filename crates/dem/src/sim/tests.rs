@@ -4,9 +4,7 @@ use super::*;
 use crate::contact::{
     Composed, Frictionless, Hertz, HertzMindlin, HertzMindlinRolling, NoDamping, NoRolling,
 };
-use crate::insertion::{random_fill, FillTarget, Region};
 use crate::walls::{MeshWall, Plane, Wall, WallShape};
-use spatter_core::distribution::SizeDistribution;
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::Motion;
 use spatter_core::rng::seeded;
@@ -44,10 +42,8 @@ fn soft() -> Material {
 }
 
 fn fill<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, n: u64, d: (f64, f64), speed: f64, seed: u64) {
-    let region = Region::Box(Aabb::new(Vec3::ZERO, Vec3::splat(l)));
     let mut rng = seeded(seed, 0);
-    let dist = SizeDistribution::Uniform { min: d.0, max: d.1 };
-    let got = random_fill(&region, &dist, FillTarget::Count(n), &[], 100_000, &mut rng);
+    let got = crate::validation::bulk::draw_order_fill(l, d, n, &mut rng);
     assert_eq!(got.len() as u64, n);
     use spatter_core::rng::RngExt;
     for (x, r) in got {
@@ -225,6 +221,52 @@ fn blow_ups_name_the_particle_the_step_and_the_cause() {
     });
     let err = sim.run_steps(1000).unwrap_err().to_string();
     assert!(err.contains("particle id 0") && err.contains("Rayleigh") && err.contains("step"), "{err}");
+}
+
+#[test]
+fn a_particle_created_overlapping_is_blamed_on_its_creation_not_on_the_time_step() {
+    // A sphere created 60 % of its radius into the floor, with a time step of 5 Rayleigh times as well:
+    // the first force evaluation already sees the overlap, so the cause is the creation (naming the
+    // wall), with the time step mentioned separately.
+    let mats = vec![soft()];
+    let new_sim = || {
+        let mut sim = Simulation::new(
+            HertzMindlin::default(),
+            mats.clone(),
+            uniform_pairs(&mats, 0.5, 0.5),
+            1e-6,
+            Settings::default(),
+        );
+        sim.add_wall(Wall {
+            name: "floor".into(),
+            shape: WallShape::Plane(Plane::new(Vec3::ZERO, Vec3::Z)),
+            material: 0,
+            motion: Motion::Fixed,
+        });
+        sim
+    };
+    let mut sim = new_sim();
+    sim.add_particle(crate::NewParticle::at(Vec3::new(0.0, 0.0, 0.004), 0.01, 0));
+    sim.dt = 5.0 * sim.rayleigh_time();
+    match sim.step() {
+        Err(crate::DemError::BlowUp { particle: 0, step: 0, what, cause, .. }) => {
+            assert!(what.starts_with("overlap with wall `floor` is 0.600"), "{what}");
+            assert!(cause.starts_with("particle id 0 was created overlapping wall `floor`"), "{cause}");
+            assert!(cause.contains("separately, the time step") && cause.contains("Rayleigh"), "{cause}");
+        }
+        other => panic!("expected a blow-up, got {other:?}"),
+    }
+    // A sphere resting on the floor for 100 steps, then a second one added half a radius into it: the
+    // blow-up comes at the later step and names the new particle and its partner.
+    let mut sim = new_sim();
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    sim.add_particle(crate::NewParticle::at(Vec3::new(0.0, 0.0, 0.01), 0.01, 0));
+    sim.run_steps(100).unwrap();
+    let b = sim.add_particle(crate::NewParticle::at(Vec3::new(0.0, 0.0, 0.025), 0.01, 0));
+    let err = sim.step().unwrap_err().to_string();
+    assert!(err.contains("at step 100") && err.contains("overlap with particle id"), "{err}");
+    assert!(err.contains(&format!("particle id {b} was created overlapping particle id 0")), "{err}");
+    // Deep overlaps reached by motion are not blamed on creation: see the time-step case above.
 }
 
 #[test]

@@ -2,7 +2,6 @@
 //! carries exactly its weight.
 
 use crate::contact::{Composed, Frictionless, Hertz, HertzMindlinRolling, NoDamping, NoRolling, PairTable};
-use crate::insertion::{random_fill, FillTarget, Region};
 use crate::particles::NewParticle;
 use crate::sim::{uniform_pairs, Settings, Simulation};
 use crate::walls::{Plane, Wall, WallShape};
@@ -11,7 +10,7 @@ use spatter_core::material::Material;
 use spatter_core::motion::Motion;
 use spatter_core::rng::{seeded, RngExt};
 use spatter_core::validation::Check;
-use spatter_core::{Aabb, Vec3};
+use spatter_core::Vec3;
 
 fn soft() -> Material {
     Material { youngs_modulus: 5e7, poisson_ratio: 0.3, density: 2500.0 }
@@ -36,11 +35,39 @@ fn box_planes<L: crate::contact::ContactLaw>(sim: &mut Simulation<L>, l: f64, si
     }
 }
 
+/// `n` non-overlapping spheres with diameters uniform in `d` placed in the box \[0, l\]³ by random
+/// sequential addition in draw order (a failed placement draws a new size and position).
+///
+/// This is the random stream the many-particle checks (here and in the engine tests) were verified with,
+/// kept so that their initial states and recorded results stay the same: the first 256 draws are
+/// consumed (an earlier fill sized its search cells from them), then each attempt draws a diameter and a
+/// centre. Scene fills use [`crate::insertion::random_fill`], which places every draw.
+pub(crate) fn draw_order_fill(
+    l: f64,
+    d: (f64, f64),
+    n: u64,
+    rng: &mut spatter_core::rng::Rng,
+) -> Vec<(Vec3, f64)> {
+    let dist = SizeDistribution::Uniform { min: d.0, max: d.1 };
+    for _ in 0..256 {
+        dist.sample(rng);
+    }
+    let mut out: Vec<(Vec3, f64)> = Vec::new();
+    while (out.len() as u64) < n {
+        let r = 0.5 * dist.sample(rng);
+        let u = Vec3::new(rng.random(), rng.random(), rng.random());
+        let x = u * l;
+        let inside = x.cmpge(Vec3::splat(r)).all() && x.cmple(Vec3::splat(l - r)).all();
+        if inside && out.iter().all(|(y, ry)| (*y - x).length_squared() >= (r + ry) * (r + ry)) {
+            out.push((x, r));
+        }
+    }
+    out
+}
+
 fn fill<L: crate::contact::ContactLaw>(sim: &mut Simulation<L>, l: f64, n: u64, speed: f64, seed: u64) {
-    let region = Region::Box(Aabb::new(Vec3::ZERO, Vec3::splat(l)));
     let mut rng = seeded(seed, 0);
-    let dist = SizeDistribution::Uniform { min: 0.008, max: 0.012 };
-    for (x, r) in random_fill(&region, &dist, FillTarget::Count(n), &[], 100_000, &mut rng) {
+    for (x, r) in draw_order_fill(l, (0.008, 0.012), n, &mut rng) {
         let mut p = NewParticle::at(x, r, 0);
         let u = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5);
         p.vel = u * 2.0 * speed;

@@ -129,6 +129,20 @@ impl Wall {
         }
     }
 
+    /// Distance from world position `x` to the wall surface with the wall placed by `kin`, if it is less
+    /// than `reach` \[m\] (a sphere of radius r centred at `x` overlaps the wall by r − distance when
+    /// the distance is below r). Behind a one-sided plane, outside a containing cylinder or inside a post
+    /// the distance is negative. Used by insertion and diagnostics, not by the force loop.
+    pub fn surface_distance(&self, kin: &WallKinematics, x: Vec3, reach: f64) -> Option<f64> {
+        let x_ref = kin.to_reference(x);
+        match &self.shape {
+            WallShape::Mesh(m) => {
+                m.bvh.closest_point(&m.mesh, x_ref, reach).map(|h| h.distance).filter(|d| *d < reach)
+            }
+            _ => self.analytic_hit(x_ref, reach).map(|h| h.2),
+        }
+    }
+
     /// The contact of a sphere at reference-frame position `x` with an analytic wall, if the surface is
     /// closer than `reach` \[m\] (meshes are handled by [`MeshWall::resolve`]).
     #[inline(always)]
