@@ -354,16 +354,17 @@ pub fn mesh_samples(mesh: &TriMesh, dp: f64, layers: usize, seed: u64) -> (Sampl
 }
 
 /// Samples the solid enclosed by a closed mesh: the surface samples moved inside along the outward
-/// normals, in `layers` layers at depths (k + ½)·dp, each particle with volume (sample area)·dp and the
-/// outward normal (into the fluid). The mesh may be oriented either way (the sign of its enclosed volume
-/// tells). A sample of a deeper layer is kept only inside the solid and no nearer to another part of the
-/// surface than half a spacing less than its depth: where faces meet at an edge, or the solid is thinner
-/// than the layers, the nearest face's samples fill the space and no particle ends up outside.
+/// normals, in `layers` layers at depths (k + ½)·dp, each with the outward normal (into the fluid). The
+/// mesh may be oriented either way (the sign of its enclosed volume tells). A sample of a deeper layer is
+/// kept only inside the solid and no nearer to another part of the surface than half a spacing less than
+/// its depth: where faces meet at an edge, or the solid is thinner than the layers, the nearest face's
+/// samples fill the space and no particle ends up outside. Volumes: see [`solid_volumes`].
 pub fn solid_samples(mesh: &TriMesh, dp: f64, layers: usize, seed: u64) -> (Samples, TriangleCoverage) {
     let ss = sample_surface(mesh, dp, seed);
     let outward = if mesh.signed_volume() < 0.0 { -1.0 } else { 1.0 };
     let bvh = TriBvh::build(mesh);
     let mut s = Samples::default();
+    let mut layer = Vec::new();
     for k in 0..layers.max(1) {
         let depth = (k as f64 + 0.5) * dp;
         for i in 0..ss.points.len() {
@@ -379,10 +380,73 @@ pub fn solid_samples(mesh: &TriMesh, dp: f64, layers: usize, seed: u64) -> (Samp
             s.pos.push(p);
             s.normal.push(n);
             s.area.push(if k == 0 { ss.areas[i] } else { 0.0 });
-            s.volume.push(ss.areas[i] * dp);
+            s.volume.push(0.0);
+            layer.push(k);
         }
     }
+    solid_volumes(mesh, &bvh, &mut s, &layer, dp);
     (s, ss.coverage)
+}
+
+/// Probe lattice spacing of [`solid_volumes`] as a fraction of dp.
+const VOLUME_PROBE: f64 = 0.25;
+
+/// Volumes of solid samples by a probe lattice of spacing dp/4: every probe inside the solid and within
+/// the depth of the layers goes to its nearest sample, and a sample's volume is its probe count times the
+/// probe volume. The volumes therefore add up to the volume of the sampled shell (to the probe
+/// resolution), overlapping slabs at edges are counted once, and irregular (gap-filled) samplings get
+/// the volumes of their Voronoi cells. `layer[j]` is the layer of sample j (0 = first, dp/2 deep).
+fn solid_volumes(mesh: &TriMesh, bvh: &TriBvh, s: &mut Samples, layer: &[usize], dp: f64) {
+    let last = layer.iter().copied().max().unwrap_or(0);
+    let mut grid = NeighbourGrid::new();
+    grid.rebuild(&s.pos, dp);
+    let step = VOLUME_PROBE * dp;
+    let cell = step * step * step;
+    // Probes are visited from every sample whose box (±reach) holds them and counted only for their
+    // nearest sample, so each probe counts once.
+    let reach = 0.75 * dp;
+    let index = |x: f64| (x / step).floor() as i64;
+    for j in 0..s.pos.len() {
+        let (x, n) = (s.pos[j], s.normal[j]);
+        let lo = [index(x.x - reach), index(x.y - reach), index(x.z - reach)];
+        let hi = [index(x.x + reach), index(x.y + reach), index(x.z + reach)];
+        let mut count = 0usize;
+        for i in lo[0]..=hi[0] {
+            for k in lo[1]..=hi[1] {
+                for l in lo[2]..=hi[2] {
+                    let q =
+                        Vec3::new((i as f64 + 0.5) * step, (k as f64 + 0.5) * step, (l as f64 + 0.5) * step);
+                    let d2 = (q - x).length_squared();
+                    if d2 > reach * reach {
+                        continue;
+                    }
+                    let mut nearest = true;
+                    grid.for_each_run(q, |run| {
+                        for &m in &grid.entries()[run] {
+                            let m = m as usize;
+                            let dm = (s.pos[m] - q).length_squared();
+                            if m != j && (dm < d2 || (dm == d2 && m < j)) {
+                                nearest = false;
+                            }
+                        }
+                    });
+                    if !nearest {
+                        continue;
+                    }
+                    // Beyond the innermost layer: not part of the sampled shell.
+                    if layer[j] == last && (q - x).dot(n) < -0.5 * dp {
+                        continue;
+                    }
+                    // Only probes near the first layer can lie outside the solid.
+                    if layer[j] == 0 && !bvh.contains_point(mesh, q) {
+                        continue;
+                    }
+                    count += 1;
+                }
+            }
+        }
+        s.volume[j] = count as f64 * cell;
+    }
 }
 
 /// All boundary particles, in canonical order (grouped by part).
@@ -630,5 +694,62 @@ mod tests {
         assert!((out.signed_volume() - 1.0).abs() < 1e-12);
         let inward = box_surface(b, [true; 6], true, Dim::Three);
         assert!((inward.signed_volume() + 1.0).abs() < 1e-12);
+    }
+
+    /// Volume of the part of a box `[0, l]³` within `depth` of its surface.
+    fn shell_volume(l: f64, depth: f64) -> f64 {
+        let inner = (l - 2.0 * depth).max(0.0);
+        l.powi(3) - inner.powi(3)
+    }
+
+    #[test]
+    fn solid_samples_fill_the_shell_of_a_cube_once_whatever_its_orientation() {
+        // The particle volumes of a solid must add up to the volume of the layers they sample (exact
+        // geometry; tolerance 2 %, the resolution of the dp/4 volume probes at the 12 edges), every particle
+        // lies inside, and the first layer lies dp/2 behind the faces. Outward and inward oriented
+        // meshes give the same sampling.
+        let dp = 0.01;
+        for (cells, layers) in [(6.0, 3), (10.0, 3), (9.0, 2)] {
+            let l = cells * dp;
+            let b = Aabb::new(Vec3::ZERO, Vec3::splat(l));
+            for inward in [false, true] {
+                let mesh = box_surface(b, [true; 6], inward, Dim::Three);
+                let (s, _) = solid_samples(&mesh, dp, layers, 7);
+                let total: f64 = s.volume.iter().sum();
+                let want = shell_volume(l, layers as f64 * dp);
+                assert!(
+                    (total - want).abs() < 0.02 * want,
+                    "{cells} dp cube, {layers} layers, inward {inward}: {total} vs {want}"
+                );
+                for (k, p) in s.pos.iter().enumerate() {
+                    let depth =
+                        [p.x, p.y, p.z, l - p.x, l - p.y, l - p.z].into_iter().fold(f64::INFINITY, f64::min);
+                    assert!(depth > 0.0, "particle {k} at {p} is outside");
+                    if s.area[k] > 0.0 {
+                        assert!((depth - 0.5 * dp).abs() < 1e-9, "first-layer particle {k} at depth {depth}");
+                        assert!(
+                            s.normal[k].dot(*p - Vec3::splat(0.5 * l)) > 0.0,
+                            "normal of {k} points inward"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_solid_thinner_than_its_layers_has_no_particle_outside() {
+        // A plate 1.5 dp thick sampled with 3 layers: deeper layers from both faces would cross; they
+        // are dropped, and the volumes still add up to the plate's volume (2 %, as above).
+        let dp = 0.01;
+        let b = Aabb::new(Vec3::ZERO, Vec3::new(0.1, 0.1, 1.5 * dp));
+        let mesh = box_surface(b, [true; 6], false, Dim::Three);
+        let (s, _) = solid_samples(&mesh, dp, 3, 3);
+        for p in &s.pos {
+            assert!(b.contains(*p), "{p} outside the plate");
+        }
+        let total: f64 = s.volume.iter().sum();
+        let want = 0.1 * 0.1 * 1.5 * dp;
+        assert!((total - want).abs() < 0.02 * want, "{total} vs {want}");
     }
 }
