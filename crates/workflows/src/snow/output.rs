@@ -248,6 +248,16 @@ pub fn save_chart(
     Ok(png)
 }
 
+/// A y range for data between `lo` and `hi` (linear axis) with room above the data for a legend of
+/// `entries` rows: the legend sits in the upper right corner and would otherwise hide the points there
+/// (about 19 px per row and 25 px of frame on a 900 × 650 picture with a plot area of ~545 px).
+pub fn y_range_with_legend(lo: f64, hi: f64, entries: usize) -> (f64, f64) {
+    let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
+    let bottom = lo - 0.05 * span;
+    let room = (0.05 + 0.035 * entries as f64).min(0.5);
+    (bottom, (hi - room * bottom) / (1.0 - room))
+}
+
 /// The regime map picture: stick red, bounce blue, interface points and the fitted boundary.
 pub fn regime_chart(
     title: &str,
@@ -266,6 +276,12 @@ pub fn regime_chart(
     let mut chart = Chart::new(title, &axes.v_label(), &axes.d_label())
         .markers(&format!("stick ({})", stick.len()), &stick, STICK_RGB)
         .markers(&format!("bounce ({})", bounce.len()), &bounce, BOUNCE_RGB);
+    let ds = records.iter().map(|r| axes.d(r.diameter));
+    let (lo, hi) = ds.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
+    if lo.is_finite() && hi.is_finite() {
+        let (y0, y1) = y_range_with_legend(lo, hi, 3);
+        chart = chart.y_range(y0, y1);
+    }
     if let Some(f) = fit {
         chart = chart.line_colored("fitted boundary v_crit(d)", &fit_curve(f, axes), INTERFACE_RGB);
     } else if !interface.is_empty() {

@@ -278,11 +278,28 @@ pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
     out
 }
 
+/// Largest relative difference of the critical speeds of `points` from those of `base` at the diameters
+/// both have (`[d, v_crit]` pairs); `None` when they share none or a diameter is missing from `base`.
+fn boundary_deviation(points: &[[f64; 2]], base: &[[f64; 2]]) -> Option<f64> {
+    if points.is_empty() {
+        return None;
+    }
+    let mut dev: f64 = 0.0;
+    for p in points {
+        let b = base.iter().find(|b| b[0] == p[0])?;
+        dev = dev.max((p[1] / b[1] - 1.0).abs());
+    }
+    Some(dev)
+}
+
 /// Adds the energy check of `impacts` simulated impacts, `created` of which left with more kinetic energy
 /// than they came with (a numerical failure), to the summary; warns when there are any. `marked` names
 /// the file and column where they are flagged.
 fn energy_check(s: &mut RunSummary, created: usize, impacts: usize, marked: &str) {
-    if created == 0 {
+    if created == 0 && impacts == 1 {
+        s.headline
+            .push("energy check: the impact did not leave with more kinetic energy than it came with".into());
+    } else if created == 0 {
         s.headline.push(format!(
             "energy check: none of {impacts} impacts left with more kinetic energy than it came with"
         ));
@@ -519,13 +536,32 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
     );
     s.headline.push(format!("{:<20} {:>8} {:>8}", "case", "sticks", "thesis"));
     let mut lines: Vec<BoundaryLine> = Vec::new();
+    // Each boundary is refined by bisection as in grid mode, so the lines show the boundary rather than
+    // the grid's steps, and the baseline's regime_map.json is the one grid mode writes.
+    let refine = cfg.grid.refine_interface && cfg.grid.angles_deg.first() == Some(&0.0);
+    let mut base_points: Vec<[f64; 2]> = Vec::new();
     for (c, case) in cases.iter().enumerate() {
         let recs = sets[c].1;
         let count = regime::stick_count(recs);
         let iface = regime::interface(recs, n_d, n_v, 0);
-        let pts: Vec<(f64, f64)> = iface.points.iter().map(|q| (axes.v(q[1]), axes.d(q[0]))).collect();
+        let points = if refine {
+            regime::refine(&models[c], &iface.brackets, cfg.bisection.relative_tolerance)
+        } else {
+            iface.points.clone()
+        };
+        let pts: Vec<(f64, f64)> = points.iter().map(|q| (axes.v(q[1]), axes.d(q[0]))).collect();
+        // A boundary within 2 % of the baseline's lies under it in the picture: the label says so.
+        let label = match boundary_deviation(&points, &base_points) {
+            Some(dev) if c > 0 && dev <= 0.02 => {
+                format!("{} ({count}; within {:.1} % of baseline)", case.name, 100.0 * dev)
+            }
+            _ => format!("{} ({count})", case.name),
+        };
+        if c == 0 {
+            base_points = points.clone();
+        }
         // The baseline is drawn last so that cases on top of it do not hide it.
-        lines.push((format!("{} ({count})", case.name), pts, output::case_colour(c)));
+        lines.push((label, pts, output::case_colour(c)));
         let cc = case_config(cfg, case);
         let sy = match cc.contact.restitution {
             RestitutionModel::Thornton { yield_stress_pa, .. } => yield_stress_pa,
@@ -548,12 +584,10 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
             case.thesis_sticks.map_or("-".to_string(), |t| t.to_string())
         ));
         let map_chart =
-            output::regime_chart(&format!("Regime map: {}", case.name), recs, &iface.points, None, &axes);
+            output::regime_chart(&format!("Regime map: {}", case.name), recs, &points, None, &axes);
         output::save_chart(&map_chart, ctx.dir, &format!("maps/case{c}"), false)?;
         if c == 0 {
-            if let Some(m) =
-                regime::regime_map(&iface.points, &cfg.fit, description(cfg, "sensitivity baseline"))
-            {
+            if let Some(m) = regime::regime_map(&points, &cfg.fit, description(cfg, "sensitivity baseline")) {
                 let jpath = ctx.dir.path("regime_map.json");
                 output::write_regime_map(&jpath, &m)?;
                 s.artifacts.push(("baseline wall rule (regime_map.json)".into(), jpath));
@@ -715,16 +749,20 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     csv.flush()?;
     s.artifacts
         .push(("stick probability with Wilson intervals".into(), ctx.dir.path("stick_probability.csv")));
+    // Diameters in µm, to the nm.
+    let um = |x: f64| (x * 1e9).round() / 1e3;
+    let (y0, y1) = output::y_range_with_legend(0.0, 1.0, 4);
     let mut chart = Chart::new(
         &format!(
-            "Stick probability on a rough wall: d = {:.3e} m on {:.3e} m spheres",
-            d, rw.bed_sphere_diameter_m
+            "Stick probability of a {} µm grain on a bed of {} µm spheres",
+            um(d),
+            um(rw.bed_sphere_diameter_m)
         ),
         "normal impact speed [m/s]",
         "stick probability",
     )
     .log_x()
-    .y_range(-0.02, 1.02)
+    .y_range(y0.max(-0.02), y1)
     .line_colored("stick probability (contact at check time)", &est, output::STICK_RGB)
     .markers("", &est, output::STICK_RGB)
     .dashed(&format!("Wilson {} % interval", 100.0 * rw.confidence), &lo_pts, (120, 120, 120))
@@ -811,22 +849,34 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
         .collect();
     let mut chart = Chart::new(
         &format!(
-            "Force–overlap history: d = {:.3e} m at {} m/s ({:?})",
-            sc.diameter_m, sc.normal_speed_m_s, r.outcome
+            "Force–overlap history: {} µm grain at {} m/s ({:?})",
+            (sc.diameter_m * 1e9).round() / 1e3,
+            sc.normal_speed_m_s,
+            r.outcome
         ),
         xl,
         yl,
     )
     .line_colored("simulated (elastic + damping)", &pts, output::STICK_RGB);
+    let mut curve: Vec<(f64, f64)> = Vec::new();
     if let Some(j) = &jkr {
         let d_max = pts.iter().map(|p| p.0).fold(0.0, f64::max).max(1.0);
-        let curve: Vec<(f64, f64)> = (0..=400)
+        curve = (0..=400)
             .filter_map(|i| {
                 let x = -1.0 + (d_max + 1.0) * i as f64 / 400.0;
                 j.force(x * j.critical_overlap).map(|f| (x, f / j.pull_off_force))
             })
             .collect();
         chart = chart.dashed("JKR curve (elastic)", &curve, output::BOUNCE_RGB);
+    }
+    let (lo, hi) = pts
+        .iter()
+        .chain(&curve)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    if lo.is_finite() && hi.is_finite() {
+        // Room for the legend above the loop, whose turning point (deepest overlap) is at the top right.
+        let (y0, y1) = output::y_range_with_legend(lo, hi, if jkr.is_some() { 2 } else { 1 });
+        chart = chart.y_range(y0, y1);
     }
     let png = output::save_chart(&chart, ctx.dir, "force_overlap", cfg.svg)?;
     s.artifacts.push(("force–overlap loop".into(), png));
