@@ -406,8 +406,7 @@ fn solid_volumes(mesh: &TriMesh, bvh: &TriBvh, s: &mut Samples, layer: &[usize],
     // nearest sample, so each probe counts once.
     let reach = 0.75 * dp;
     let index = |x: f64| (x / step).floor() as i64;
-    for j in 0..s.pos.len() {
-        let (x, n) = (s.pos[j], s.normal[j]);
+    for (j, ((&x, &n), vol)) in s.pos.iter().zip(&s.normal).zip(s.volume.iter_mut()).enumerate() {
         let lo = [index(x.x - reach), index(x.y - reach), index(x.z - reach)];
         let hi = [index(x.x + reach), index(x.y + reach), index(x.z + reach)];
         let mut count = 0usize;
@@ -445,7 +444,7 @@ fn solid_volumes(mesh: &TriMesh, bvh: &TriBvh, s: &mut Samples, layer: &[usize],
                 }
             }
         }
-        s.volume[j] = count as f64 * cell;
+        *vol = count as f64 * cell;
     }
 }
 
