@@ -27,6 +27,8 @@
 //! The impact speed V that sets e is the normal impact speed of the run (the thesis computed e per run
 //! and passed it to LIGGGHTS as a constant coefficient of restitution, digest §2.5).
 
+use crate::contact::restitution_fit::DampingTable;
+use crate::contact::RestitutionCalibration;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 
@@ -197,10 +199,17 @@ impl Validate for RestitutionModel {
     }
 }
 
-/// A damping law for the DEM engine whose coefficient of restitution follows a [`RestitutionModel`]: when
-/// a contact forms, e is evaluated at that contact's normal impact speed (−v_rel·n) and turned into the
-/// dashpot coefficient of [`RestitutionDamping`] (same calibration and clamp options); it then stays
-/// fixed for the life of the contact, as the snow thesis did per run.
+/// A damping law for the DEM engine whose coefficient of restitution follows a [`RestitutionModel`] per
+/// pair: when a contact forms, e is evaluated at that contact's normal impact speed (−v_rel·n) and turned
+/// into the dashpot coefficient of [`RestitutionDamping`](crate::contact::RestitutionDamping) (same
+/// calibration and clamp options); it then stays fixed for the life of the contact, as the snow thesis
+/// did per run.
+///
+/// The model of a pair is its [`PairProps::restitution_model`] when set, else `model`; so one engine runs
+/// pairs with a constant e next to pairs with Thornton's e(V) (the `dem` scene's `restitution_model`
+/// key). A constant model's coefficient is computed once per pair type; a speed-dependent one is looked
+/// up per contact formation in the shared [`DampingTable`] (exact calibration, 1e-6 in e) or from the
+/// closed form (linearised).
 ///
 /// The yield velocity uses the pair's E* ([`PairProps::e_star`]); [`YieldGeometry::Pair`] the contact's R*
 /// and m* (Thornton's two-sphere result, right for any contact), [`YieldGeometry::Wall`] the density of
@@ -209,16 +218,24 @@ impl Validate for RestitutionModel {
 /// wall formula into the pair one and leave the choice without effect.
 ///
 /// [`PairProps::e_star`]: crate::contact::PairProps::e_star
+/// [`PairProps::restitution_model`]: crate::contact::PairProps::restitution_model
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpeedDependentDamping {
+    /// The model of pairs that have none of their own.
     pub model: RestitutionModel,
     /// Calibration, tensile clamp and tangential options (its pair restitution is ignored).
     pub base: crate::contact::RestitutionDamping,
 }
 
 /// Per-pair parameters of [`SpeedDependentDamping`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct SpeedDependentParams {
+    /// The pair's model.
+    pub model: RestitutionModel,
+    /// The dimensionless coefficient of a constant model, computed once.
+    pub fixed_c_n: Option<f64>,
+    /// Tabulated inverse e ↦ c for speed-dependent models under the exact calibration.
+    pub table: Option<std::sync::Arc<DampingTable>>,
     pub e_star: f64,
     /// Density of the pair's first material \[kg/m³\] ([`YieldGeometry::Wall`]).
     pub density: f64,
@@ -241,7 +258,20 @@ impl crate::contact::DampingLaw for SpeedDependentDamping {
     type State = SpeedDependentState;
 
     fn params(&self, _pair_index: usize, props: &crate::contact::PairProps, p: f64) -> SpeedDependentParams {
+        let model = props.restitution_model.unwrap_or(self.model);
+        let (fixed_c_n, table) = match model {
+            RestitutionModel::Constant { restitution } => (Some(self.base.coefficient(restitution, p)), None),
+            RestitutionModel::Thornton { .. } => match self.base.calibration {
+                RestitutionCalibration::Exact => {
+                    (None, Some(DampingTable::shared(p, self.base.tensile_clamp)))
+                }
+                RestitutionCalibration::Linearised => (None, None),
+            },
+        };
         SpeedDependentParams {
+            model,
+            fixed_c_n,
+            table,
             e_star: props.e_star,
             density: props.materials[0].density,
             exponent: p,
@@ -261,10 +291,19 @@ impl crate::contact::DampingLaw for SpeedDependentDamping {
             return;
         }
         s.formed = true;
-        let v = (-c.v_rel.dot(c.normal)).max(0.0);
-        let props = ImpactProps { e_star: p.e_star, density: p.density, r_star: c.r_eff, m_star: c.m_eff };
-        let e = self.model.restitution(v, &props);
-        s.c_n = self.base.coefficient(e, p.exponent);
+        s.c_n = match p.fixed_c_n {
+            Some(c_n) => c_n,
+            None => {
+                let v = (-c.v_rel.dot(c.normal)).max(0.0);
+                let props =
+                    ImpactProps { e_star: p.e_star, density: p.density, r_star: c.r_eff, m_star: c.m_eff };
+                let e = p.model.restitution(v, &props);
+                match &p.table {
+                    Some(t) => t.coefficient(e),
+                    None => self.base.coefficient(e, p.exponent),
+                }
+            }
+        };
     }
 
     #[inline]

@@ -23,8 +23,11 @@ pub struct PairProps {
     pub restitution: f64,
     /// Work of adhesion Γ \[J/m²\] for adhesive normal laws (0 = none).
     pub work_of_adhesion: f64,
-    /// Yield stress σ_y \[Pa\] for plastic restitution models (`None` = not given).
-    pub yield_stress: Option<f64>,
+    /// Coefficient-of-restitution model of the pair, read by the speed-dependent damping law
+    /// ([`crate::restitution_models::SpeedDependentDamping`], e.g. Thornton's e(V) with a yield stress);
+    /// `None` lets that law use its own model. [`super::RestitutionDamping`] always uses the constant
+    /// `restitution`.
+    pub restitution_model: Option<crate::restitution_models::RestitutionModel>,
 }
 
 impl PairProps {
@@ -39,7 +42,7 @@ impl PairProps {
             rolling_viscous: 0.0,
             restitution,
             work_of_adhesion: 0.0,
-            yield_stress: None,
+            restitution_model: None,
         }
     }
 }

@@ -250,6 +250,27 @@ pub struct PairValues {
     /// Work of adhesion Γ \[J/m²\] for `jkr`, `dmt`, `sjkr` (default 0).
     #[serde(default)]
     pub work_of_adhesion_j_m2: f64,
+    /// `constant` (default: `restitution`) or `thornton` (e(V) from `yield_stress_pa`, fixed per contact
+    /// at its impact speed).
+    #[serde(default)]
+    pub restitution_model: RestitutionKind,
+    /// Yield stress σ_y \[Pa\] of `thornton` (p_y = 2.5 σ_y); required there, not allowed otherwise.
+    #[serde(default)]
+    pub yield_stress_pa: Option<f64>,
+    /// `full` (default) or `power_law` form of Thornton's e(V).
+    #[serde(default)]
+    pub thornton_form: crate::restitution_models::ThorntonForm,
+}
+
+/// How a pair's coefficient of restitution is given.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RestitutionKind {
+    /// The same e at every impact speed (`restitution`).
+    #[default]
+    Constant,
+    /// Thornton's (1997) elastic–perfectly-plastic e(V), yield velocity from the contact's E*, R*, m*.
+    Thornton,
 }
 
 fn half() -> f64 {
@@ -264,6 +285,9 @@ impl Default for PairValues {
             rolling_friction: 0.0,
             rolling_viscous_s_m: 0.0,
             work_of_adhesion_j_m2: 0.0,
+            restitution_model: RestitutionKind::Constant,
+            yield_stress_pa: None,
+            thornton_form: Default::default(),
         }
     }
 }
@@ -284,6 +308,12 @@ pub struct PairOverride {
     pub rolling_viscous_s_m: Option<f64>,
     #[serde(default)]
     pub work_of_adhesion_j_m2: Option<f64>,
+    #[serde(default)]
+    pub restitution_model: Option<RestitutionKind>,
+    #[serde(default)]
+    pub yield_stress_pa: Option<f64>,
+    #[serde(default)]
+    pub thornton_form: Option<crate::restitution_models::ThorntonForm>,
 }
 
 /// A wall.
@@ -536,6 +566,25 @@ fn check_pair_values(c: &mut Checker, v: &PairValues) {
     c.non_negative("rolling_friction", v.rolling_friction);
     c.non_negative("rolling_viscous_s_m", v.rolling_viscous_s_m);
     c.non_negative("work_of_adhesion_j_m2", v.work_of_adhesion_j_m2);
+    check_restitution_model(c, v.restitution_model, v.yield_stress_pa, v.yield_stress_pa.is_some());
+}
+
+/// `yield_stress_pa` is required by and only allowed with `restitution_model = "thornton"`; `written`
+/// says whether this table itself gives it (an inherited value is not an error).
+fn check_restitution_model(c: &mut Checker, kind: RestitutionKind, yield_stress: Option<f64>, written: bool) {
+    match (kind, yield_stress) {
+        (RestitutionKind::Thornton, None) => c.fail(
+            "yield_stress_pa",
+            "restitution_model = \"thornton\" needs yield_stress_pa, the yield stress σ_y in Pa (e.g. 1e6)"
+                .to_string(),
+        ),
+        (RestitutionKind::Thornton, Some(y)) => c.positive("yield_stress_pa", y),
+        (RestitutionKind::Constant, Some(y)) if written => c.fail(
+            "yield_stress_pa",
+            format!("yield_stress_pa = {y} is used only with restitution_model = \"thornton\""),
+        ),
+        (RestitutionKind::Constant, _) => {}
+    }
 }
 
 impl Validate for SceneConfig {
@@ -607,14 +656,18 @@ impl Validate for SceneConfig {
                 for (k, m) in p.materials.iter().enumerate() {
                     check_material_name(c, self, &format!("materials[{k}]"), m);
                 }
-                let v = PairValues {
-                    friction: p.friction.unwrap_or(0.0),
-                    restitution: p.restitution.unwrap_or(1.0),
-                    rolling_friction: p.rolling_friction.unwrap_or(0.0),
-                    rolling_viscous_s_m: p.rolling_viscous_s_m.unwrap_or(0.0),
-                    work_of_adhesion_j_m2: p.work_of_adhesion_j_m2.unwrap_or(0.0),
-                };
-                check_pair_values(c, &v);
+                c.non_negative("friction", p.friction.unwrap_or(0.0));
+                c.in_range("restitution", p.restitution.unwrap_or(1.0), 0.0, false, 1.0, true);
+                c.non_negative("rolling_friction", p.rolling_friction.unwrap_or(0.0));
+                c.non_negative("rolling_viscous_s_m", p.rolling_viscous_s_m.unwrap_or(0.0));
+                c.non_negative("work_of_adhesion_j_m2", p.work_of_adhesion_j_m2.unwrap_or(0.0));
+                let d = &self.pair_defaults;
+                check_restitution_model(
+                    c,
+                    p.restitution_model.unwrap_or(d.restitution_model),
+                    p.yield_stress_pa.or(d.yield_stress_pa),
+                    p.yield_stress_pa.is_some(),
+                );
             });
         }
         for (i, w) in self.walls.iter().enumerate() {

@@ -10,6 +10,7 @@ use crate::contact::{
 use crate::error::DemError;
 use crate::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
 use crate::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
+use crate::restitution_models::{RestitutionModel, SpeedDependentDamping};
 use crate::sim::{SimState, Simulation};
 use crate::timestep;
 use serde::{Deserialize, Serialize};
@@ -54,37 +55,76 @@ pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> 
     };
     let jkr = JkrLaw { break_criterion: c.jkr_break, damping: c.jkr_damping, coulomb: c.adhesive_coulomb };
     let r = c.rolling;
+    let built = setup::build(cfg)?;
+    if built.speed_dependent_restitution() {
+        // Some pair has a speed-dependent e: the damping law keeps each contact's coefficient in its
+        // state (16 bytes more per contact), so it gets engines of its own; scenes with constant e only
+        // keep the default law. Every pair carries its model, the law's own is never used.
+        let d = SpeedDependentDamping {
+            model: RestitutionModel::Constant { restitution: cfg.pair_defaults.restitution },
+            base: damping,
+        };
+        let variant = MindlinVariant { history: c.tangential.mindlin_history().unwrap_or_default() };
+        let ac = c.adhesive_coulomb;
+        return match (c.normal, c.tangential) {
+            (NormalKind::Hertz, TangentialKind::Linear) => {
+                run_with(tracked(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hertz, _) => {
+                run_with(tracked(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hooke, TangentialKind::Linear) => {
+                run_with(tracked(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hooke, _) => {
+                run_with(tracked(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Jkr, _) => {
+                run_with(tracked(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Dmt, _) => {
+                run_with(tracked(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Sjkr, _) => {
+                run_with(tracked(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg), built, cfg, ctx)
+            }
+        };
+    }
     // One monomorphised engine per combination.
     match (c.normal, c.tangential) {
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
-            run_with(tracked(Composed::new(Hertz, damping, Mindlin, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hertz, TangentialKind::Linear) => {
-            run_with(tracked(Composed::new(Hertz, damping, linear, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Mindlin) => {
-            run_with(tracked(Composed::new(hooke, damping, Mindlin, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
-            run_with(tracked(Composed::new(hooke, damping, linear, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
         }
         // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
         (NormalKind::Hertz, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(tracked(Composed::new(Hertz, damping, t, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(tracked(Composed::new(hooke, damping, t, r), cfg), cfg, ctx)
+            run_with(tracked(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
         }
-        (NormalKind::Jkr, _) => run_with(tracked(Composed::new(jkr, damping, Mindlin, r), cfg), cfg, ctx),
+        (NormalKind::Jkr, _) => {
+            run_with(tracked(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
+        }
         (NormalKind::Dmt, _) => run_with(
             tracked(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            built,
             cfg,
             ctx,
         ),
         (NormalKind::Sjkr, _) => run_with(
             tracked(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            built,
             cfg,
             ctx,
         ),
@@ -150,8 +190,12 @@ fn tracked<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> Comp
     law
 }
 
-fn run_with<L: ContactLaw>(law: L, cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> {
-    let built = setup::build(cfg)?;
+fn run_with<L: ContactLaw>(
+    law: L,
+    built: setup::Built,
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+) -> Result<RunSummary, DemError> {
     let e = &cfg.engine;
     let settings = crate::sim::Settings {
         integrator: e.integrator,

@@ -9,6 +9,7 @@ use crate::insertion::{
     WallClearance,
 };
 use crate::particles::NewParticle;
+use crate::restitution_models::{RestitutionModel, YieldGeometry};
 use crate::walls::{Cylinder, MeshWall, Plane, Rectangle, Wall, WallShape};
 use spatter_core::distribution::SizeDistribution;
 use spatter_core::material::Material;
@@ -36,6 +37,16 @@ pub struct Built {
     pub materials: Vec<Material>,
     pub pairs: PairTable<PairProps>,
     pub walls: Vec<Wall>,
+}
+
+impl Built {
+    /// Whether some pair's restitution depends on the impact speed (the scene then runs the
+    /// speed-dependent damping law, whose contacts carry their coefficient).
+    pub fn speed_dependent_restitution(&self) -> bool {
+        let n = self.pairs.types();
+        (0..n * n)
+            .any(|k| matches!(self.pairs.at(k).restitution_model, Some(RestitutionModel::Thornton { .. })))
+    }
 }
 
 fn material_index(cfg: &SceneConfig, name: &str, key: &str) -> Result<u16, DemError> {
@@ -74,6 +85,15 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
             if let Some(w) = p.work_of_adhesion_j_m2 {
                 v.work_of_adhesion_j_m2 = w;
             }
+            if let Some(k) = p.restitution_model {
+                v.restitution_model = k;
+            }
+            if let Some(y) = p.yield_stress_pa {
+                v.yield_stress_pa = Some(y);
+            }
+            if let Some(f) = p.thornton_form {
+                v.thornton_form = f;
+            }
         }
     }
     let pairs = PairTable::build(n, |a, b| {
@@ -82,6 +102,16 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         p.rolling_friction = v.rolling_friction;
         p.rolling_viscous = v.rolling_viscous_s_m;
         p.work_of_adhesion = v.work_of_adhesion_j_m2;
+        p.restitution_model = Some(match v.restitution_model {
+            RestitutionKind::Constant => RestitutionModel::Constant { restitution: v.restitution },
+            RestitutionKind::Thornton => RestitutionModel::Thornton {
+                yield_stress_pa: v.yield_stress_pa.unwrap_or(0.0),
+                form: v.thornton_form,
+                // Eq. 31 with the contact's R* and m*: Thornton's result for two spheres, equal to the
+                // wall formula (Eq. 32) on a wall, and free of the question which material is the particle.
+                yield_geometry: YieldGeometry::Pair,
+            },
+        });
         p
     });
     let mut walls = Vec::new();

@@ -324,3 +324,132 @@ fn a_fill_that_does_not_fit_is_an_error_naming_the_key() {
         "{err}"
     );
 }
+
+/// One sphere of `d` (m) at `centre` moving at `v` (m/s), as a one-site cubic lattice fill.
+fn one_sphere(centre: [f64; 3], d: f64, v: [f64; 3]) -> String {
+    let r = 0.5 * d;
+    let lo = [centre[0] - r, centre[1] - r, centre[2] - r];
+    let hi = [centre[0] + r + 1e-9, centre[1] + r + 1e-9, centre[2] + r + 1e-9];
+    format!(
+        r#"
+[[fill]]
+material = "grain"
+method = "lattice"
+lattice = "cubic"
+spacing_m = {d}
+region = {{ type = "box", min_m = [{}, {}, {}], max_m = [{}, {}, {}] }}
+size = {{ kind = "mono", diameter = {d} }}
+velocity_m_s = [{}, {}, {}]
+"#,
+        lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], v[0], v[1], v[2]
+    )
+}
+
+#[test]
+fn the_restitution_model_is_chosen_per_pair() {
+    // Two 10 mm grains (E = 50 MPa, ν = 0.3, ρ = 2500) fall at 2 m/s, without gravity, onto two steel
+    // plates of different materials: grain–plate_a uses Thornton's e(V) with σ_y = 1 MPa, grain–plate_b
+    // the constant e = 0.5. Reference for plate_a: Thornton (1997) with the pair yield velocity (thesis
+    // Eq. 31) V_y = 3.194 √(p_y⁵R*³/(E*⁴m*)), p_y = 2.5 σ_y, R* = r, m* = m (a wall), E* from the two
+    // materials; e = thornton_full(V, V_y) (checked against Thornton's closed form in
+    // restitution_models). Realised e: exact calibration (table, 1e-6 in e) and velocity Verlet at
+    // ~2000 steps per contact, whose error is O(Δt²) (2e-5 here): 2e-4 absolute.
+    let tmp = tempfile::tempdir().unwrap();
+    let d = 0.01;
+    let r = 0.5 * d;
+    let v0 = 2.0;
+    let mut text = String::from(
+        r#"
+dt_s = 2e-7
+duration_s = 6e-4
+output_interval_s = 6e-4
+gravity_m_s2 = [0, 0, 0]
+
+[materials.grain]
+youngs_modulus_pa = 5e7
+poisson_ratio = 0.3
+density_kg_m3 = 2500
+
+[materials.plate_a]
+youngs_modulus_pa = 2e11
+poisson_ratio = 0.3
+density_kg_m3 = 7800
+
+[materials.plate_b]
+youngs_modulus_pa = 2e11
+poisson_ratio = 0.3
+density_kg_m3 = 7800
+
+[pair_defaults]
+friction = 0.3
+restitution = 0.5
+
+[[pairs]]
+materials = ["grain", "plate_a"]
+restitution_model = "thornton"
+yield_stress_pa = 1e6
+
+[[walls]]
+name = "a"
+material = "plate_a"
+shape = { type = "rectangle", center_m = [-0.05, 0, 0], half_u_m = [0.03, 0, 0], half_v_m = [0, 0.03, 0] }
+
+[[walls]]
+name = "b"
+material = "plate_b"
+shape = { type = "rectangle", center_m = [0.05, 0, 0], half_u_m = [0.03, 0, 0], half_v_m = [0, 0.03, 0] }
+"#,
+    );
+    text.push_str(&one_sphere([-0.05, 0.0, r + 1e-4], d, [0.0, 0.0, -v0]));
+    text.push_str(&one_sphere([0.05, 0.0, r + 1e-4], d, [0.0, 0.0, -v0]));
+    let cfg = parse(&text);
+    Checker::run(&cfg, None).unwrap();
+    let dir = RunDir::create(&tmp.path().join("run")).unwrap();
+    let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    let vtu = spatter_io::vtu::read(&dir.root().join("particles/particles_00001.vtu")).unwrap();
+    let (ids, vel) = (&vtu.point_data["id"].1, &vtu.point_data["velocity_m_s"].1);
+    let x = &vtu.points;
+    let mut e = [0.0; 2];
+    for k in 0..ids.len() {
+        assert!(x[k].z > r + 1e-4, "rebounded and left the plate");
+        e[if x[k].x < 0.0 { 0 } else { 1 }] = vel[3 * k + 2] / v0;
+    }
+    let e_star: f64 = 1.0 / ((1.0 - 0.09) / 5e7 + (1.0 - 0.09) / 2e11);
+
+    let m = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let p_y: f64 = 2.5e6;
+    let v_y = 3.194 * (p_y.powi(5) * r.powi(3) / (e_star.powi(4) * m)).sqrt();
+    let e_a = crate::restitution_models::thornton_full(v0, v_y);
+    assert!((v_y - 0.1022).abs() < 1e-3 && (e_a - 0.5).abs() > 0.05, "V_y = {v_y}, e = {e_a}");
+    assert!((e[0] - e_a).abs() < 2e-4, "Thornton pair: e = {} vs {e_a}", e[0]);
+    assert!((e[1] - 0.5).abs() < 2e-4, "constant pair: e = {} vs 0.5", e[1]);
+}
+
+#[test]
+fn restitution_model_keys_are_checked() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+    cfg.pair_defaults.restitution_model = RestitutionKind::Thornton;
+    cfg.pairs[0].yield_stress_pa = Some(-3.0);
+    cfg.pairs[0].restitution_model = Some(RestitutionKind::Thornton);
+    let errs = Checker::run(&cfg, None).unwrap_err();
+    let find =
+        |k: &str| errs.iter().find(|e| e.key == k).unwrap_or_else(|| panic!("no error for {k}: {errs:?}"));
+    assert!(find("pair_defaults.yield_stress_pa").message.contains("needs yield_stress_pa"));
+    assert!(find("pairs[0].yield_stress_pa").message.contains("positive"));
+    cfg.pair_defaults = PairValues::default();
+    cfg.pairs[0].restitution_model = None;
+    cfg.pairs[0].yield_stress_pa = Some(1e6);
+    let errs = Checker::run(&cfg, None).unwrap_err();
+    assert_eq!(
+        errs[0].message, "yield_stress_pa = 1000000 is used only with restitution_model = \"thornton\"",
+        "{errs:?}"
+    );
+    assert!(toml::from_str::<PairValues>("restitution_model = \"walton\"").is_err());
+    let v: PairValues = toml::from_str(
+        "restitution_model = \"thornton\"\nyield_stress_pa = 2e6\nthornton_form = \"power_law\"",
+    )
+    .unwrap();
+    assert_eq!(v.thornton_form, crate::restitution_models::ThorntonForm::PowerLaw);
+}
