@@ -332,7 +332,7 @@ fn run_with<L: ContactLaw>(
 /// walls where they are now.
 fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
     let t = sim.time();
-    if inj.due(t) == 0 && inj.state.pending.is_some() {
+    if t < inj.start || (inj.due(t) == 0 && inj.state.pending.is_some()) {
         return;
     }
     let reach = region.bounds().inflated(sim.particles.radius.iter().copied().fold(0.0, f64::max));
