@@ -95,7 +95,8 @@ pub struct FluidConfig {
     #[serde(default = "d_density")]
     pub density_kg_m3: f64,
     /// Largest flow speed expected, U_max; default estimated from the fill height (dam-break front speed
-    /// 2√(gH)), the fill velocities and the wall speeds.
+    /// 2√(gH)), the fill velocities and the wall speeds. A given value can raise U_max above that estimate,
+    /// never lower it below.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_velocity_m_s: Option<f64>,
     /// c₀ = factor · U_max, factor ≥ 10.
