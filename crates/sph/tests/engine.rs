@@ -2,7 +2,6 @@
 //! results independent of the thread count, particles leaving the domain removed and counted.
 
 use spatter_core::mesh::TriMesh;
-use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::{Aabb, Vec3};
 use spatter_sph::boundary::Sampling;
 use spatter_sph::scene::wetting::{wet_area, wetting_map};
