@@ -62,7 +62,8 @@ pub struct SphParams {
     /// Particles whose density leaves `[lo, hi]·ρ₀` are removed and counted. Default [0.7, 1.3].
     pub density_window: [f64; 2],
     /// A boundary particle is wet while a fluid particle is within this distance \[m\] of the surface point
-    /// it stands for (dp/2 in front of a lattice wall particle; a mesh sample itself). Default 1.0·dp.
+    /// it stands for (dp/2 in front of a lattice or solid wall particle; a shell sample itself, with the
+    /// distance grown by dp, `Sampling::wet_reach`). Default 1.0·dp.
     pub wet_distance: f64,
     /// A particle stopped at a wall it would have crossed is put back this far in front of it, as a
     /// fraction of dp. Default 0.2.

@@ -165,7 +165,8 @@ pub(crate) struct Consts {
     pub eos_gamma: f64,
     pub eos: crate::eos::Tait,
     pub akinci: AkinciSplines,
-    pub wet_d2: f64,
+    /// Squared wet distance per part, the wet distance plus [`crate::boundary::Sampling::wet_reach`].
+    pub wet_d2: Vec<f64>,
     /// Distance from a wall particle to the surface point it stands for, per part (dp/2 for lattice walls).
     pub wet_offset: Vec<f64>,
     pub slip_free: Vec<bool>,
@@ -261,6 +262,7 @@ pub(crate) fn wall_state(
                     let xb = wl.pos[b];
                     // Wetness is judged from the point of the wall surface the particle stands for.
                     let part = wl.part[b] as usize;
+                    let wet_d2 = c.wet_d2[part];
                     let xs = if c.wet_offset[part] > 0.0 {
                         let f = &wl.frames[part];
                         xb + f.rot * wl.ref_normal[wl.src[b] as usize] * c.wet_offset[part]
@@ -280,7 +282,7 @@ pub(crate) fn wall_state(
                                     spw += c.eos.pressure(set.rho[j]) * w;
                                     srx += dx * (set.rho[j] * w);
                                     svw += set.vel[j] * w;
-                                    is_wet |= (xs - set.pos[j]).length_squared() < c.wet_d2;
+                                    is_wet |= (xs - set.pos[j]).length_squared() < wet_d2;
                                 }
                             }
                         });

@@ -447,7 +447,12 @@ impl Simulation {
             eos_gamma: p.gamma,
             eos,
             akinci: crate::kernel::AkinciSplines::new(support),
-            wet_d2: p.wet_distance * p.wet_distance,
+            wet_d2: self
+                .boundary
+                .parts
+                .iter()
+                .map(|q| (p.wet_distance + q.sampling.wet_reach(p.spacing)).powi(2))
+                .collect(),
             wet_offset: self.boundary.parts.iter().map(|q| q.sampling.surface_offset(p.spacing)).collect(),
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }

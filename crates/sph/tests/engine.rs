@@ -36,11 +36,11 @@ fn wet_area_does_not_depend_on_the_mesh() {
         let mut plate = TriMesh::rectangle(0.4, 0.4, 0.0, nx, ny);
         plate.map_vertices(|v| v - Vec3::new(0.2, 0.2, 0.0));
         sim.add_mesh("plate", plate, Some(1), None, WallOptions::default()).unwrap();
-        // A one-layer disc of water of radius 0.1 m, 0.6 dp above the plate.
+        // A one-layer disc of water of radius 0.1 m, 1.5 dp above the plate (where a shell holds water).
         let mut pts = Vec::new();
         for j in -12..12 {
             for i in -12..12 {
-                let x = Vec3::new((i as f64 + 0.5) * dp, (j as f64 + 0.5) * dp, 0.6 * dp);
+                let x = Vec3::new((i as f64 + 0.5) * dp, (j as f64 + 0.5) * dp, 1.5 * dp);
                 if x.x.hypot(x.y) < 0.1 {
                     pts.push(x);
                 }
@@ -56,11 +56,56 @@ fn wet_area_does_not_depend_on_the_mesh() {
         assert!(matches!(sim.boundary.parts[0].sampling, Sampling::Mesh(_)));
         areas.push(wa.wet_now);
     }
-    // Wet where a fluid particle is within dp: the disc grown by about dp (particle centres reach 0.1 − dp/2).
-    let footprint = std::f64::consts::PI * (0.1f64 - 0.5 * dp + 0.5 * dp).powi(2);
+    // A shell particle is wet while a fluid particle is within dp + dp (wet distance plus the shell's reach):
+    // particle centres reach 0.1 − dp/2, grown by √((2dp)² − (1.5dp)²) = 1.32 dp in the plane.
+    let reach = ((2.0 * dp).powi(2) - (1.5 * dp).powi(2)).sqrt();
+    let footprint = std::f64::consts::PI * (0.1f64 - 0.5 * dp + reach).powi(2);
     assert!((areas[0] - areas[1]).abs() < 0.03 * areas[1], "coarse {} vs fine {}", areas[0], areas[1]);
     for a in &areas {
         assert!((a - footprint).abs() < 0.15 * footprint, "wet area {a} vs footprint {footprint}");
+    }
+}
+
+/// Water resting on a one-layer shell reads wet: the shell holds it about 1.5 dp off its particles, and
+/// the wet distance is measured from the surface dp in front of the sheet (`Sampling::wet_reach`). Still
+/// water filled onto the plate, and water dropped 5 cm onto it; every plate particle under the water (away
+/// from the tank walls) is wet at the end.
+#[test]
+fn water_on_a_thin_shell_reads_wet() {
+    for fill_bottom in [0.05, 0.1] {
+        let dp = 0.01;
+        let mut p = SphParams::water(Dim::Three, dp, 20.0);
+        p.gravity = Vec3::new(0.0, 0.0, -9.81);
+        let mut sim = Simulation::new(p);
+        let tank = Aabb::new(Vec3::ZERO, Vec3::new(0.2, 0.2, 0.3));
+        sim.add_tank("tank", tank, OPEN_TOP, None, None, WallOptions::default());
+        let mut plate = TriMesh::rectangle(0.24, 0.24, 0.0, 12, 12);
+        plate.map_vertices(|v| Vec3::new(v.x - 0.02, v.y - 0.02, 0.05));
+        let k = sim.add_mesh("plate", plate, Some(1), None, WallOptions::default()).unwrap();
+        let lo = Vec3::new(0.0, 0.0, fill_bottom);
+        sim.fill_box(Aabb::new(lo, lo + Vec3::new(0.2, 0.2, 0.1)), Vec3::ZERO, true);
+        sim.initialize().unwrap();
+        while sim.time < 0.2 {
+            sim.step().unwrap();
+        }
+        let b = &sim.boundary;
+        let part = &b.parts[k];
+        let under: Vec<usize> = (part.start..part.end)
+            .filter(|&i| {
+                let x = b.position(i);
+                x.x > 2.0 * dp && x.x < 0.2 - 2.0 * dp && x.y > 2.0 * dp && x.y < 0.2 - 2.0 * dp
+            })
+            .collect();
+        let gap = sim.fluid.pos.iter().map(|x| x.z - 0.05).fold(f64::INFINITY, f64::min) / dp;
+        let dry = under.iter().filter(|&&i| !b.wet[i]).count();
+        assert!(under.len() > 100);
+        assert_eq!(
+            dry,
+            0,
+            "fill from z = {fill_bottom}: {dry} of {} plate particles dry, gap {gap:.2} dp",
+            under.len()
+        );
+        assert!(gap > 1.0 && gap < 2.0, "the shell holds the water {gap:.2} dp off");
     }
 }
 

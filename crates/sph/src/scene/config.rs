@@ -355,7 +355,8 @@ pub struct HeightConfig {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorConfig {
-    /// A wall particle is wet while fluid is within this distance (default: dp).
+    /// A wall particle is wet while fluid is within this distance \[m\] of the surface it stands for
+    /// (default: dp; shells reach dp further, `Sampling::wet_reach`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wet_distance_m: Option<f64>,
     #[serde(default)]
