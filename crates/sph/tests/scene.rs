@@ -119,7 +119,7 @@ fn bad_values_are_named_with_their_key() {
 #[test]
 fn shipped_examples_are_valid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
-    for name in ["sph_dam_break.toml", "sph_wheel.toml"] {
+    for name in ["sph_dam_break.toml", "sph_wheel.toml", "sph_baffle.toml"] {
         let text = std::fs::read_to_string(root.join(name)).unwrap();
         let body: String =
             text.lines().filter(|l| !l.trim_start().starts_with("kind")).collect::<Vec<_>>().join("\n");
