@@ -20,7 +20,8 @@ Examples:
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
   spatter bench dem                              # throughput of an engine
-  spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV";
+  spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV
+  spatter sessile --adhesion 0.6,0.8,1.0         # SPH contact angle per wall adhesion factor (calibration)";
 
 #[derive(Parser, Debug)]
 #[command(name = "spatter", version, about = "Particles that hit, stick to, wet and wear surfaces.", after_help = EXAMPLES)]
@@ -88,6 +89,34 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// SPH sessile drops: the static contact angle each wall adhesion factor gives, to calibrate `adhesion`
+    /// against a measured contact angle (docs/sph.md, "Sessile-drop calibration").
+    #[command(
+        after_help = "Examples:\n  spatter sessile --adhesion 0.6,0.8,1.0\n  spatter sessile --adhesion 0.9 --dimensions 3 --resolution 8 --csv angles.csv"
+    )]
+    Sessile {
+        /// Wall adhesion factors (multiples of the liquid's cohesion), comma-separated, each in [0, 10].
+        #[arg(long, value_delimiter = ',', required = true, allow_hyphen_values = true)]
+        adhesion: Vec<f64>,
+        /// 2 (half-disc drop, the validated setting) or 3 (hemisphere).
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+        dimensions: u8,
+        /// Particles across the drop radius, 4 to 40; use the particle spacing of your run (R/dp).
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(4..=40))]
+        resolution: u32,
+        /// Drop radius [m], in (0, 0.1].
+        #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true)]
+        radius_m: f64,
+        /// Surface tension of the liquid [N/m], in (0, 1].
+        #[arg(long, default_value_t = 0.072)]
+        surface_tension_n_m: f64,
+        /// Simulated time in capillary times √(ρR³/σ), 1 to 100.
+        #[arg(long, default_value_t = 12.0)]
+        capillary_times: f64,
+        /// Also write the table to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
     /// Run a named benchmark and print its throughput.
     #[command(after_help = "Example:\n  spatter bench dem\n  spatter bench snow --quick")]
     Bench {
@@ -111,6 +140,25 @@ fn main() -> ExitCode {
         Command::Validate { quick, case, csv } => commands::validate(quick, case.as_deref(), csv.as_deref()),
         Command::Bench { engine, quick } => commands::bench(&engine, quick),
         Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
+        Command::Sessile {
+            adhesion,
+            dimensions,
+            resolution,
+            radius_m,
+            surface_tension_n_m,
+            capillary_times,
+            csv,
+        } => commands::sessile::run(
+            &commands::sessile::Request {
+                adhesion,
+                dimensions,
+                resolution: resolution as usize,
+                radius_m,
+                surface_tension_n_m,
+                capillary_times,
+            },
+            csv.as_deref(),
+        ),
     };
     match result {
         Ok(code) => code,

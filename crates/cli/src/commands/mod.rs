@@ -1,6 +1,7 @@
 //! One function per subcommand.
 
 pub mod run;
+pub mod sessile;
 
 use crate::registry;
 use anyhow::Result;
