@@ -158,3 +158,18 @@ fn several_problems_are_listed_together() {
         ],
     );
 }
+
+#[test]
+fn ice_temperature_above_melting() {
+    let text = edited("# ice_temperature_c = -12.0", "ice_temperature_c = 5.0");
+    let l = line_of(&text, "ice_temperature_c = 5.0");
+    rejects(
+        "ice.toml",
+        text.as_bytes(),
+        &[
+            &format!("ice.toml:{l}:21"),
+            "key `ice_temperature_c`",
+            "ice_temperature_c = 5 is outside [-40, 0]",
+        ],
+    );
+}

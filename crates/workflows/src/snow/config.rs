@@ -674,6 +674,11 @@ pub struct SnowConfig {
     /// The impacting particle (ice, thesis Table 2).
     #[serde(default = "ice")]
     pub particle: Material,
+    /// Temperature of the ice particle \[°C\], in \[−40, 0\]. When given, the particle's Young's modulus
+    /// is E_ice(T) of thesis Eq. 20 ([`super::material::ice_youngs_modulus`]) and replaces `particle.youngs_modulus_pa`
+    /// (sensitivity cases that set a modulus still replace it in turn). See [`SnowConfig::resolved`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ice_temperature_c: Option<f64>,
     /// The wall (ABS, thesis Table 2); also the material of wall spheres and the rough-wall bed.
     #[serde(default = "abs")]
     pub wall: Material,
@@ -708,6 +713,23 @@ fn yes() -> bool {
     true
 }
 
+/// Accepted `ice_temperature_c` \[°C\]: ice below its melting point, and not so cold that the fit of
+/// thesis Eq. 20 (measurements mostly at −12 °C) is stretched far beyond its data (E = 10.5 GPa at −30 °C,
+/// 11.5 GPa at −40 °C).
+pub const ICE_TEMPERATURE_RANGE_C: (f64, f64) = (-40.0, 0.0);
+
+impl SnowConfig {
+    /// The configuration the run uses: `ice_temperature_c`, when given, turned into the particle's
+    /// Young's modulus by thesis Eq. 20; otherwise a copy.
+    pub fn resolved(&self) -> SnowConfig {
+        let mut c = self.clone();
+        if let Some(t) = self.ice_temperature_c {
+            c.particle.youngs_modulus = super::material::ice_youngs_modulus(t);
+        }
+        c
+    }
+}
+
 /// Ice (thesis Table 2): E = 9.8 GPa, ν = 0.31, ρ = 920 kg/m³.
 pub fn ice() -> Material {
     Material { youngs_modulus: 9.8e9, poisson_ratio: 0.31, density: 920.0 }
@@ -724,6 +746,7 @@ impl Default for SnowConfig {
         SnowConfig {
             mode: Mode::Grid,
             particle: ice(),
+            ice_temperature_c: None,
             wall: abs(),
             target: TargetKind::Wall,
             partner_diameter_m: None,
@@ -745,6 +768,16 @@ impl Validate for SnowConfig {
         c.item("particle", &self.particle);
         if self.particle.youngs_modulus.is_infinite() {
             c.fail("particle.youngs_modulus_pa", "the particle must have a finite Young's modulus");
+        }
+        if let Some(t) = self.ice_temperature_c {
+            c.in_range(
+                "ice_temperature_c",
+                t,
+                ICE_TEMPERATURE_RANGE_C.0,
+                true,
+                ICE_TEMPERATURE_RANGE_C.1,
+                true,
+            );
         }
         c.item("wall", &self.wall);
         if let Some(d) = self.partner_diameter_m {

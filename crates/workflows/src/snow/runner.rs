@@ -153,6 +153,7 @@ fn completed(ctx: &RunContext<'_>) {
 /// Runs the `snow_regime_map` scenario `cfg` into `ctx.dir`.
 pub fn run(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
     Checker::run(cfg, None).map_err(SnowError::Invalid)?;
+    let cfg = &cfg.resolved();
     let dt_warning = super::dt_guard::warning(cfg);
     if let Some(w) = &dt_warning {
         tracing::warn!("{w}");
@@ -265,6 +266,12 @@ pub fn material_report(cfg: &SnowConfig) -> Vec<String> {
         (_, super::config::TargetKind::Particle) => "a free partner particle",
     };
     let mut out = Vec::new();
+    if let Some(t) = cfg.ice_temperature_c {
+        out.push(format!(
+            "particle Young's modulus from ice_temperature_c = {t} °C (thesis Eq. 20): {:.5e} Pa",
+            super::material::ice_youngs_modulus(t)
+        ));
+    }
     for c in contact_reports(cfg) {
         out.push(format!(
             "contact at d = {:.3e} m with {target}: E* = {:.5e} Pa, R* = {:.5e} m, m* = {:.5e} kg; Tabor parameter (z0 = 0.4 / 0.2 nm) {:.3} / {:.3} (JKR valid above 5)",

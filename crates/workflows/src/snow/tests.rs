@@ -131,6 +131,38 @@ fn small(mode: Mode) -> SnowConfig {
 }
 
 #[test]
+fn ice_temperature_sets_the_particle_modulus() {
+    use super::material::ice_youngs_modulus;
+    // Thesis Eq. 20 at −12 °C: 9.7724 GPa (digest §4.1 V3), to the 5 digits quoted.
+    let cfg = SnowConfig { ice_temperature_c: Some(-12.0), ..small(Mode::Grid) };
+    assert!((cfg.resolved().particle.youngs_modulus / 9.7724e9 - 1.0).abs() < 1e-5);
+    assert_eq!(SnowConfig::default().resolved(), SnowConfig::default(), "no temperature: no change");
+    // A grid run at −12 °C equals, impact for impact, one with that modulus written out, and says where
+    // its modulus came from.
+    let mut explicit = small(Mode::Grid);
+    explicit.particle.youngs_modulus = ice_youngs_modulus(-12.0);
+    let root = tempfile::tempdir().unwrap();
+    let mut csv = Vec::new();
+    for (name, c) in [("temperature", &cfg), ("explicit", &explicit)] {
+        let d = RunDir::create(&root.path().join(name)).unwrap();
+        let s = run(c, &RunContext { dir: &d, control: &Unattended, resume: false }).unwrap();
+        assert_eq!(
+            s.headline.iter().any(|l| l.contains("from ice_temperature_c = -12 °C")),
+            name == "temperature"
+        );
+        csv.push(std::fs::read(d.root().join("impacts.csv")).unwrap());
+    }
+    assert_eq!(csv[0], csv[1]);
+    // Above melting, or colder than the fit is stretched: refused, naming the key and the range.
+    for t in [0.5, -41.0, f64::NAN] {
+        let bad = SnowConfig { ice_temperature_c: Some(t), ..Default::default() };
+        let e = Checker::run(&bad, None).unwrap_err();
+        assert_eq!(e[0].key, "ice_temperature_c");
+        assert!(e[0].message.contains("outside [-40, 0]"), "{}", e[0].message);
+    }
+}
+
+#[test]
 fn interrupted_and_resumed_runs_equal_uninterrupted_ones() {
     let root = tempfile::tempdir().unwrap();
     for mode in [Mode::Grid, Mode::Bisection, Mode::Sensitivity, Mode::RoughWall] {
