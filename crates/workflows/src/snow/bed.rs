@@ -2,8 +2,8 @@
 //!
 //! The thesis made its rough wall by inserting 1 µm ABS spheres at random positions in a box, overlaps
 //! allowed, and raised the volume fraction "to receive a suitable surface roughness" (digest §2.8; the
-//! fractions are not published). [`random_insertion`] does exactly that; [`settled`] instead drops the
-//! spheres into the box and relaxes them under gravity until no two overlap (a loose random packing).
+//! fractions are not published). [`random_insertion`] does exactly that; [`settled`] instead settles the
+//! spheres geometrically into the box until no two overlap (a loose random packing; no dynamics).
 //! Bed spheres are frozen: infinite mass, no motion (digest §4.4 — free wall spheres give nonsense).
 
 use super::impact::BedSphere;
@@ -60,8 +60,9 @@ pub fn random_insertion(width: f64, thickness: f64, d: f64, fraction: f64, rng: 
     finish(centres, r, width, thickness)
 }
 
-/// Spheres dropped into the box (side walls, floor z = 0) and relaxed under gravity by projected
-/// non-overlap steps until the largest overlap is below 10⁻³ d.
+/// Spheres settled into the box (side walls, floor z = 0) geometrically, without dynamics: every sphere is
+/// lowered by 0.1 r per iteration (a kinematic stand-in for gravity) and the overlaps are projected apart
+/// after each, then projection alone continues until the largest overlap is below 10⁻³ d.
 pub fn settled(width: f64, thickness: f64, d: f64, fraction: f64, rng: &mut Rng) -> Bed {
     let r = 0.5 * d;
     let n = sphere_count(width, thickness, d, fraction);
