@@ -136,17 +136,11 @@ pub fn lattice_fill(region: &Region, spacing: f64, r: f64, lattice: Lattice) -> 
     out
 }
 
-/// Largest diameter a distribution can produce, if bounded: the diameter of `mono`, the upper end of
-/// `uniform`, mean + 3σ of the truncated `normal`, the last diameter of a `tabulated` one; `None` for the
-/// unbounded log-normal.
+/// Largest diameter a distribution can produce, if bounded \[m\] ([`SizeDistribution::max_diameter`]): the
+/// diameter of `mono`, the upper end of `uniform`, mean + 3σ of the truncated `normal`, the last diameter of
+/// a `tabulated` one; `None` for the unbounded log-normal.
 pub fn max_diameter(d: &SizeDistribution) -> Option<f64> {
-    match d {
-        SizeDistribution::Mono { diameter } => Some(*diameter),
-        SizeDistribution::Uniform { max, .. } => Some(*max),
-        SizeDistribution::Normal { mean, std_dev } => Some(mean + 3.0 * std_dev),
-        SizeDistribution::LogNormal { .. } => None,
-        SizeDistribution::Tabulated { diameters, .. } => diameters.last().copied(),
-    }
+    d.max_diameter()
 }
 
 /// Standard normal quantile of 1 − 10⁻⁶ (Abramowitz & Stegun 1964, table 26.1).

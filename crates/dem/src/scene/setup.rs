@@ -20,15 +20,18 @@ use spatter_core::{Aabb, Vec3};
 
 pub use crate::insertion::max_diameter;
 
-/// Smallest diameter a distribution can produce (a lower bound for the time-step check).
+/// Standard normal quantile of 10⁻³ (Abramowitz & Stegun 1964, table 26.1: z = −3.090 23).
+const Z_1E3: f64 = -3.090_232_3;
+
+/// Diameter for the time-step check \[m\]: the smallest diameter the distribution can produce
+/// ([`SizeDistribution::min_diameter`], e.g. max(mean − 3σ, mean/10) of the truncated normal), or for the
+/// log-normal, which is unbounded below, its 10⁻³ quantile median × σ_g^−3.09 (one draw in a thousand is
+/// smaller).
 pub fn min_diameter(d: &SizeDistribution) -> f64 {
-    match d {
-        SizeDistribution::Mono { diameter } => *diameter,
-        SizeDistribution::Uniform { min, .. } => *min,
-        SizeDistribution::Normal { mean, std_dev } => (mean - 3.0 * std_dev).max(0.1 * mean),
-        // The 0.1 % quantile.
-        SizeDistribution::LogNormal { median, geometric_std } => median * (-3.09 * geometric_std.ln()).exp(),
-        SizeDistribution::Tabulated { diameters, .. } => diameters[0],
+    match (d.min_diameter(), d) {
+        (Some(dmin), _) => dmin,
+        (None, SizeDistribution::LogNormal { median, geometric_std }) => median * geometric_std.powf(Z_1E3),
+        (None, _) => unreachable!("only the log-normal is unbounded below"),
     }
 }
 

@@ -453,3 +453,33 @@ fn restitution_model_keys_are_checked() {
     .unwrap();
     assert_eq!(v.thornton_form, crate::restitution_models::ThorntonForm::PowerLaw);
 }
+
+#[test]
+fn the_time_step_check_sees_the_smallest_diameter_a_distribution_can_draw() {
+    // setup::min_diameter sizes the time-step warning for injected particles; for every bounded
+    // distribution no draw may be smaller (exact: the bound is the sampler's own). The wide normal
+    // (σ = 0.5 mean) is the case that used to break it: truncated at f64::MIN_POSITIVE, it drew
+    // Φ(−1.8) − Φ(−2) = 1.3 % of its particles below the assumed floor mean/10 (Abramowitz & Stegun
+    // table 26.1), about 1300 of the 10⁵ draws here.
+    use spatter_core::distribution::{PsdBasis, SizeDistribution};
+    let dists = [
+        SizeDistribution::Mono { diameter: 1e-3 },
+        SizeDistribution::Uniform { min: 1e-3, max: 2e-3 },
+        SizeDistribution::Normal { mean: 1e-3, std_dev: 0.2e-3 },
+        SizeDistribution::Normal { mean: 1e-3, std_dev: 0.5e-3 },
+        SizeDistribution::Tabulated {
+            diameters: vec![1e-3, 2e-3, 4e-3],
+            cumulative: vec![0.0, 0.5, 1.0],
+            basis: PsdBasis::Mass,
+        },
+    ];
+    for (k, d) in dists.iter().enumerate() {
+        let floor = setup::min_diameter(d);
+        let mut rng = spatter_core::rng::seeded(3, k as u64);
+        let below = (0..100_000).filter(|_| d.sample(&mut rng) < floor).count();
+        assert_eq!(below, 0, "{d:?}: {below} draws below {floor:e}");
+    }
+    // The normal's floor is max(mean − 3σ, mean/10): 0.4 mm and 0.1 mm here.
+    assert_eq!(setup::min_diameter(&dists[2]), 1e-3 - 3.0 * 0.2e-3);
+    assert_eq!(setup::min_diameter(&dists[3]), 0.1 * 1e-3);
+}
