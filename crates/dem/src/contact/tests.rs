@@ -226,6 +226,45 @@ fn constant_torque_rolling_stops_without_reversing() {
     assert!(((steps as f64) * dt - t_stop).abs() <= 2.0 * dt, "{} vs {t_stop}", steps as f64 * dt);
 }
 
+#[test]
+fn viscous_rolling_torque_has_the_model_b_value_and_direction() {
+    // Ai et al. (2011) model B: M = −μ_rv R*² F_n ω_roll with ω_roll = ω_rel − (ω_rel·n) n (twist about n
+    // excluded), dissipating M·ω_roll = μ_rv R*² F_n |ω_roll|² (W, × Δt per step). Glass sphere r = 1 cm
+    // on a rigid wall (R* = r), δ = 1 µm, F_n = (4/3) E* √R* δ^{3/2} (Johnson 1985 §4.2; no damping, no
+    // friction, so the rolling torque is the only output besides F_n), μ_rv = 0.3 s/m, ω_rel = (2, −1,
+    // 5) rad/s with n = ẑ. Tolerance 1e-12 relative (round-off only).
+    let mut props = PairProps::new(&glass(), &rigid(0.2), 0.5, 1.0);
+    props.rolling_viscous = 0.3;
+    let law = Composed::new(Hertz, NoDamping, Frictionless, ViscousRolling);
+    let p = law.params(0, &props);
+    let (r, m, dt, overlap) = (0.01, 2800.0 * 4.0 / 3.0 * PI * 1e-6, 1e-6, 1e-6);
+    let mut c = input(overlap, Vec3::ZERO, r, m, dt);
+    c.w_rel = Vec3::new(2.0, -1.0, 5.0);
+    let out = law.compute(&p, &c, &mut Default::default()).unwrap();
+    let f_n = 4.0 / 3.0 * props.e_star * (r * overlap).sqrt() * overlap;
+    assert!((out.normal_force / f_n - 1.0).abs() < 1e-12, "{} vs {f_n}", out.normal_force);
+    let w_roll = Vec3::new(2.0, -1.0, 0.0);
+    let expect = -0.3 * r * r * f_n * w_roll;
+    assert!(
+        (out.rolling_torque - expect).length() < 1e-12 * expect.length(),
+        "{} vs {expect}",
+        out.rolling_torque
+    );
+    let diss = 0.3 * r * r * f_n * w_roll.length_squared() * dt;
+    assert!((out.dissipated / diss - 1.0).abs() < 1e-12, "{} vs {diss}", out.dissipated);
+    // The torque is linear in ω_roll (twice the rotation, twice the torque) and independent of the twist.
+    c.w_rel = Vec3::new(4.0, -2.0, -7.0);
+    let out2 = law.compute(&p, &c, &mut Default::default()).unwrap();
+    assert!((out2.rolling_torque - 2.0 * expect).length() < 1e-12 * expect.length());
+    // No-reversal limit: with Δt larger than the decay time I_eff/(μ_rv R*² F_n) the torque is capped at
+    // I_eff |ω_roll|/Δt, which stops the relative rolling rotation in one step and no more.
+    c.w_rel = w_roll;
+    c.dt = 10.0 * c.i_eff / (0.3 * r * r * f_n);
+    let out3 = law.compute(&p, &c, &mut Default::default()).unwrap();
+    let w_next = w_roll + out3.rolling_torque / c.i_eff * c.dt;
+    assert!(w_next.length() < 1e-12 * w_roll.length(), "after one step ω_roll = {w_next}");
+}
+
 /// Work absorbed by a Mindlin spring (no dashpot, no sliding) over the cycle: displace by `d` along x at
 /// stiffness `k0`, change the stiffness to `k1` at rest, then move back until the force has vanished.
 fn stiffness_cycle(history: MindlinHistory, k0: f64, k1: f64, d: f64) -> f64 {

@@ -678,6 +678,60 @@ fn a_sphere_rolling_on_a_rotating_plate_orbits_at_two_sevenths_of_its_rate() {
 }
 
 #[test]
+fn viscous_rolling_resistance_slows_a_rolling_sphere_exponentially() {
+    // A sphere (r = 1 cm) rolling without slipping on a plane under gravity, with viscous rolling
+    // resistance (Ai et al. 2011 model B, M = −μ_rv R*² F_n ω_roll; on a wall R* = r, F_n = mg at rest,
+    // ω_roll = ω). Angular momentum about the contact point, L = (I + mr²) ω = (7/5) m r² ω, changes
+    // only by the rolling torque (the contact force acts at that point, gravity along the line through
+    // it): (7/5) m r² ω′ = −μ_rv r² m g ω, so ω(t) = ω₀ e^{−t/τ} and v = rω, with τ = 7/(5 μ_rv g)
+    // independent of r and m. μ_rv = 0.7136 s/m gives τ = 0.2 s; 2τ is run. Started at the static Hertz
+    // overlap (Johnson 1985 §4.2) with v₀ = 0.1 m/s and ω₀ = v₀/r, so it rolls from the first step.
+    // Tolerance 2·10⁻⁴ v₀ on v and r ω from t = 20 ms on, after the ring-down (dashpot of e = 0.5) of the
+    // tangential spring, which takes up the friction force m v′ the deceleration needs (measured 2.1·10⁻⁵
+    // v₀). Without rolling resistance v stays at v₀ (0.86 v₀ off at 2τ); the constant torque of model A
+    // would decelerate linearly.
+    let mats = vec![soft()];
+    let mut pairs = uniform_pairs(&mats, 0.5, 0.5);
+    let mu_rv = 0.7136;
+    pairs = pairs.map(|_, p| PairProps { rolling_viscous: mu_rv, ..p.clone() });
+    let law: Composed<
+        Hertz,
+        crate::contact::RestitutionDamping,
+        crate::contact::Mindlin,
+        crate::contact::ViscousRolling,
+    > = Composed::default();
+    let mut sim = Simulation::new(law, mats, pairs.clone(), 2e-5, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    sim.add_wall(Wall {
+        name: "floor".into(),
+        shape: WallShape::Plane(Plane::new(Vec3::ZERO, Vec3::Z)),
+        material: 0,
+        motion: Motion::Fixed,
+    });
+    let (r, v0, g) = (0.01, 0.1, 9.81);
+    let m = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let delta = (3.0 * m * g / (4.0 * pairs.get(0, 0).e_star * r.sqrt())).powf(2.0 / 3.0);
+    let mut p = crate::NewParticle::at(Vec3::new(0.0, 0.0, r - delta), r, 0);
+    p.vel = Vec3::new(v0, 0.0, 0.0);
+    p.omega = Vec3::new(0.0, v0 / r, 0.0);
+    sim.add_particle(p);
+    let tau = 7.0 / (5.0 * mu_rv * g);
+    let mut worst: f64 = 0.0;
+    let steps = (2.0 * tau / sim.dt).round() as u64;
+    for _ in 0..steps {
+        sim.step().unwrap();
+        let t = sim.time();
+        if t >= 0.02 {
+            let expect = v0 * (-t / tau).exp();
+            let (v, w) = (sim.particles.vel[0].x, sim.particles.omega[0].y);
+            worst = worst.max((v - expect).abs()).max((r * w - expect).abs());
+        }
+    }
+    assert!((sim.time() - 2.0 * tau).abs() < sim.dt);
+    assert!(worst < 2e-4 * v0, "largest deviation from v₀ e^(−t/τ): {worst} m/s");
+}
+
+#[test]
 fn a_tabulated_floor_carries_a_sphere_along_its_prescribed_path() {
     // A floor plane whose vertical speed is tabulated: 0.1 m/s at t = 0, −0.1 at 0.5 s, 0 at 1 s (linear
     // in between; accelerations −0.4 and +0.2 m/s², below g, so the sphere stays on it). Its height is the
