@@ -179,3 +179,104 @@ fn a_sphere_bounces_off_a_rectangle_misses_it_outside_and_is_deflected_by_its_ed
     assert!((v - expect).abs().max_element() < 5e-3, "edge: {v} vs {expect}");
     assert!((v.length() - 1.0).abs() < 1e-5, "elastic: |v| = {}", v.length());
 }
+
+/// The aluminium sphere of [`impact`] (r = 1 cm, μ = 0.3, e = 0.8, Δt = t_c/200 at 1 m/s) against the
+/// two-triangle STL square as floor, optionally under a rigid analytic ceiling at height `ceiling`, no
+/// gravity.
+fn on_stl_floor(dir: &Path, x0: Vec3, v0: Vec3, ceiling: Option<f64>) -> Simulation<HertzMindlin> {
+    let al = Material::new(70e9, 0.3, 2699.0).unwrap();
+    let mats = vec![al.clone(), Material::new(f64::INFINITY, 0.3, 2699.0).unwrap()];
+    let pairs = uniform_pairs(&mats, 0.3, 0.8);
+    let r = 0.01;
+    let m = 2699.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let tc = spatter_core::timestep::hertz_time(m, r, pairs.get(0, 1).e_star, 1.0);
+    let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, tc / 200.0, Settings::default());
+    let floor = WallShape::Mesh(Box::new(MeshWall::new(two_triangle_square(dir))));
+    sim.add_wall(Wall { name: "floor".into(), shape: floor, material: 1, motion: Motion::Fixed });
+    if let Some(h) = ceiling {
+        let shape = WallShape::Plane(Plane::new(Vec3::new(0.0, 0.0, h), -Vec3::Z));
+        sim.add_wall(Wall { name: "ceiling".into(), shape, material: 1, motion: Motion::Fixed });
+    }
+    let mut p = NewParticle::at(x0, r, 0);
+    p.vel = v0;
+    sim.add_particle(p);
+    sim
+}
+
+fn floor_records<L: crate::contact::ContactLaw>(sim: &Simulation<L>) -> &MeshRecords {
+    match &sim.walls[0].shape {
+        WallShape::Mesh(m) => &m.records,
+        _ => unreachable!("wall 0 is the STL floor"),
+    }
+}
+
+#[test]
+fn stl_impact_records_equal_the_momentum_change_and_count_each_impact_once() {
+    // No gravity, so the contact force alone changes the momentum, and under velocity Verlet
+    // v_out − v_in = Σ_k F_k Δt/m exactly (the half kicks of consecutive steps add up, F = 0 before and
+    // after the contact): the records Σ|F_n|Δt and Σ|F_t|Δt must equal m |Δv_n| = m (v_in + v_out) and,
+    // for an impact sliding throughout (F_t keeps its direction), m |Δv_t|. Tolerance 1e-9 relative:
+    // round-off only. Impacts at a face point, on the shared diagonal edge and at the shared corner
+    // vertex, straight down at 1 m/s and oblique at (3, 0, −1) m/s: 3 > (7/2) μ (1 + e) = 1.89, so the
+    // contact slides for its whole duration (Maw, Barber & Fawcett 1976; Chung & Ooi 2011 test 4). Each
+    // is one impact on exactly one triangle, whose mean impact speed is the approach speed 1 m/s (1e-12:
+    // nothing acts before the contact).
+    let dir = tempfile::tempdir().unwrap();
+    let r = 0.01;
+    let h = r + 1e-5;
+    for (name, xy) in [("face", (0.7, 0.25)), ("edge", (0.5, 0.5)), ("vertex", (0.0, 0.0))] {
+        for v0 in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(3.0, 0.0, -1.0)] {
+            let mut sim = on_stl_floor(dir.path(), Vec3::new(xy.0, xy.1, h), v0, None);
+            sim.run_steps(600).unwrap();
+            assert_eq!(sim.last_evaluation().wall_contacts, 0, "{name} {v0}: the impact is over");
+            let m = 1.0 / sim.particles.inv_mass[0];
+            let v1 = sim.particles.vel[0];
+            assert!(v1.z > 0.5, "{name} {v0}: bounced ({v1})");
+            let rec = floor_records(&sim);
+            let jn: f64 = rec.normal_impulse.iter().sum();
+            let jt: f64 = rec.tangential_impulse.iter().sum();
+            let dv_n = m * (v1.z - v0.z);
+            let dv_t = m * (v1 - v0).truncate().length();
+            assert!((jn / dv_n - 1.0).abs() < 1e-9, "{name} {v0}: normal impulse {jn} vs m Δv_n {dv_n}");
+            if v0.x == 0.0 {
+                assert!(jt <= 1e-9 * jn, "{name} {v0}: tangential impulse {jt} of a head-on impact");
+            } else {
+                assert!(dv_t > 0.1 * dv_n, "{name} {v0}: friction acted ({dv_t})");
+                assert!(
+                    (jt / dv_t - 1.0).abs() < 1e-9,
+                    "{name} {v0}: tangential impulse {jt} vs m Δv_t {dv_t}"
+                );
+            }
+            let hit: Vec<usize> = (0..rec.impacts.len()).filter(|&t| rec.impacts[t] > 0).collect();
+            assert_eq!(hit.len(), 1, "{name} {v0}: impacts per triangle {:?}", rec.impacts);
+            assert_eq!(rec.impacts[hit[0]], 1, "{name} {v0}: impacts per triangle {:?}", rec.impacts);
+            let speed = rec.impact_speed_sum[hit[0]];
+            assert!((speed - 1.0).abs() < 1e-12, "{name} {v0}: mean impact speed {speed}");
+        }
+    }
+    // Two bounces on the shared edge, with a rigid ceiling 0.1 mm above the rebounding sphere: two
+    // impacts, and the impulse is the floor's share of the momentum changes, m (u₁ − u₀ + u₃ − u₂), with
+    // u₀ … u₃ the vertical free-flight velocities between the contacts (floor, ceiling, floor).
+    let mut sim =
+        on_stl_floor(dir.path(), Vec3::new(0.5, 0.5, h), Vec3::new(0.0, 0.0, -1.0), Some(2.0 * r + 1e-4));
+    let mut free: Vec<f64> = vec![-1.0];
+    let mut steps = 0;
+    while free.len() < 4 && steps < 20_000 {
+        sim.step().unwrap();
+        steps += 1;
+        let vz = sim.particles.vel[0].z;
+        if sim.last_evaluation().wall_contacts == 0 && vz != *free.last().unwrap() {
+            free.push(vz);
+        }
+    }
+    assert_eq!(free.len(), 4, "floor, ceiling, floor: free-flight speeds {free:?}");
+    assert!(free[1] > 0.0 && free[2] < 0.0 && free[3] > 0.0, "{free:?}");
+    let m = 1.0 / sim.particles.inv_mass[0];
+    let rec = floor_records(&sim);
+    assert_eq!(rec.impacts.iter().sum::<u64>(), 2, "impacts per triangle {:?}", rec.impacts);
+    let jn: f64 = rec.normal_impulse.iter().sum();
+    let expect = m * (free[1] - free[0] + free[3] - free[2]);
+    assert!((jn / expect - 1.0).abs() < 1e-9, "normal impulse {jn} vs {expect}");
+    let speeds: f64 = rec.impact_speed_sum.iter().sum();
+    assert!((speeds - (1.0 - free[2])).abs() < 1e-12, "impact speeds {speeds} vs 1 + {}", -free[2]);
+}
