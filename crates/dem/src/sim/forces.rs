@@ -541,7 +541,9 @@ impl<L: ContactLaw> Simulation<L> {
             };
             let id = if new(a) { a } else { b };
             let mut s = format!(
-                "particle id {id} was created overlapping {partner} (this was its first force evaluation, so                  the time step is not the cause); check where particles are added (fill and inject regions                  against walls and other particles, lattice spacing, radii)"
+                "particle id {id} was created overlapping {partner} (this was its first force evaluation, so \
+                 the time step is not the cause); check where particles are added (fill and inject regions \
+                 against walls and other particles, lattice spacing, radii)"
             );
             if let Some(d) = dt_note {
                 s.push_str(&format!("; separately, {d}"));

@@ -263,6 +263,9 @@ fn a_particle_created_overlapping_is_blamed_on_its_creation_not_on_the_time_step
             assert!(what.starts_with("overlap with wall `floor` is 0.600"), "{what}");
             assert!(cause.starts_with("particle id 0 was created overlapping wall `floor`"), "{cause}");
             assert!(cause.contains("separately, the time step") && cause.contains("Rayleigh"), "{cause}");
+            // One space between words: no runs left by a broken string continuation.
+            assert!(!cause.contains("  ") && !what.contains("  "), "{cause:?}");
+            assert!(cause.contains("so the time step is not the cause"), "{cause}");
         }
         other => panic!("expected a blow-up, got {other:?}"),
     }
@@ -276,6 +279,7 @@ fn a_particle_created_overlapping_is_blamed_on_its_creation_not_on_the_time_step
     let err = sim.step().unwrap_err().to_string();
     assert!(err.contains("at step 100") && err.contains("overlap with particle id"), "{err}");
     assert!(err.contains(&format!("particle id {b} was created overlapping particle id 0")), "{err}");
+    assert!(!err.contains("  "), "{err:?}");
     // Deep overlaps reached by motion are not blamed on creation: see the time-step case above.
 }
 
