@@ -140,3 +140,119 @@ fn the_resolved_configuration_round_trips_through_toml() {
     assert_eq!(back, cfg);
     assert!(resolved.contains("artificial_viscosity = 0.02"), "defaults are written out:\n{resolved}");
 }
+
+/// Reads a CSV table with a text column: the header and the rows of fields.
+fn read_table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let split = |l: &str| l.split(',').map(str::to_owned).collect::<Vec<_>>();
+    let mut lines = text.lines();
+    let head = split(lines.next().unwrap());
+    (head, lines.map(split).collect())
+}
+
+/// Field `name` of a table row, as a number.
+fn field(head: &[String], row: &[String], name: &str) -> f64 {
+    let k = head.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name}"));
+    row[k].parse().unwrap_or_else(|_| panic!("{name} = {} is not a number", row[k]))
+}
+
+/// Column `name` of a numeric series.
+fn column(cols: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+    let k = cols.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name}"));
+    rows.iter().map(|r| r[k]).collect()
+}
+
+/// Two slabs of water in zero gravity: A, 0.2 m wide, z ∈ [0, 0.2] m at t = 0, moving up at 0.4 m/s, and B,
+/// 0.1 m wide, z ∈ [0.2, 0.4] m, moving down at 0.4 m/s, 0.3 m apart. At the rest density nothing acts on
+/// them: they move rigidly (exactly: every pair has zero pressure and relative velocity).
+const SLABS: &str = r#"
+[fluid]
+dimensions = 2
+spacing_m = 0.01
+gravity_m_s2 = [0.0, 0.0, 0.0]
+[domain]
+min_m = [-0.5, -1.0, -0.5]
+max_m = [1.0, 1.0, 1.0]
+[[fill]]
+type = "box"
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.2, 0.0, 0.2]
+velocity_m_s = [0.0, 0.0, 0.4]
+[[fill]]
+type = "box"
+min_m = [0.5, 0.0, 0.2]
+max_m = [0.6, 0.0, 0.4]
+velocity_m_s = [0.0, 0.0, -0.4]
+[output]
+end_time_s = 0.2
+vtu_interval_s = 0.2
+sample_interval_s = 0.01
+[sensors.height]
+base_z_m = 0.0
+bin_m = 0.02
+bins = 25
+window_s = [0.1, 0.2]
+"#;
+
+/// Length of [a, b] ∩ [lo, hi].
+fn overlap(a: f64, b: f64, lo: f64, hi: f64) -> f64 {
+    (b.min(hi) - a.max(lo)).max(0.0)
+}
+
+/// Moving slabs (`SLABS`): the volume crossing each plane is the slab's width times the length of slab
+/// that passes it in the window, upward for A and downward for B, and the mean volume per bin is the
+/// time-average of the slabs' overlap with it. Also with the run ending inside the window (end 0.15 s):
+/// both are averaged over the part of the window the run covered (until 2026-11-24 such a run reported
+/// zero flux).
+#[test]
+fn moving_slabs_give_the_volume_flux_and_mean_volume_per_bin() {
+    let (wa, wb, v, dp, bin) = (0.2, 0.1, 0.4, 0.01, 0.02);
+    let t0 = 0.1;
+    for end in [0.2, 0.15] {
+        let cfg = config(&SLABS.replace("end_time_s = 0.2", &format!("end_time_s = {end}")));
+        let tmp = tempfile::tempdir().unwrap();
+        run_to_end(&cfg, tmp.path());
+        let (cols, rows) = spatter_io::csv::read_series(&tmp.path().join("series.csv")).unwrap();
+        let dt_max = column(&cols, &rows, "dt_s").iter().copied().fold(0.0, f64::max);
+        // The run stops at the first step end at or after end_time_s; the last row is written there.
+        let t1 = column(&cols, &rows, "t_s").last().copied().unwrap().min(0.2);
+        let span = t1 - t0;
+        let (head, rows) = read_table(&tmp.path().join("splash_height.csv"));
+        assert_eq!(rows.len(), 25);
+        for row in &rows {
+            let zp = field(&head, row, "bin_low_m");
+            // Rows of A pass the plane z_p in the window if they started at z_p − v t, t in the window; rows
+            // of B if they started at z_p + v t. Rows cross the planes at 0.0125 s + k 0.025 s, at least
+            // 0.011 s (12 steps) from the window's ends (0.1 s; 0.15 or 0.2 s, or the step end just after
+            // them), so the count is exact: tolerance round-off (1e-9 relative).
+            let up = wa * overlap(zp - v * t1, zp - v * t0, 0.0, 0.2) / span;
+            let down = wb * overlap(zp + v * t0, zp + v * t1, 0.2, 0.4) / span;
+            let got_up = field(&head, row, "upward_flux_lower_edge_m3_s");
+            let got_net = field(&head, row, "net_flux_lower_edge_m3_s");
+            assert!(
+                (got_up - up).abs() <= 1e-9 * wa * v,
+                "end {end}, plane {zp}: up {got_up}, expected {up}"
+            );
+            assert!(
+                (got_net - (up - down)).abs() <= 1e-9 * wa * v,
+                "end {end}, plane {zp}: net {got_net}, expected {}",
+                up - down
+            );
+            // Mean volume in [z_p, z_p + bin]: time-average of the slabs' overlap with the bin (midpoint rule,
+            // 10⁴ points; the overlap is piecewise linear). The sensor samples the volume at step ends, so
+            // each row entering or leaving the bin counts up to one step too long or too short: tolerance two
+            // such rows of A, 2 W_A dp dt_max / span (a bin meets at most one slab edge, two rows).
+            let n = 10_000;
+            let mut want = 0.0;
+            for i in 0..n {
+                let t = t0 + (i as f64 + 0.5) / n as f64 * span;
+                want += wa * overlap(zp, zp + bin, v * t, 0.2 + v * t)
+                    + wb * overlap(zp, zp + bin, 0.2 - v * t, 0.4 - v * t);
+            }
+            want /= n as f64;
+            let got = field(&head, row, "mean_volume_m3");
+            let tol = 2.0 * wa * dp * dt_max / span;
+            assert!((got - want).abs() <= tol, "end {end}, bin {zp}: {got} m², expected {want} ± {tol} m²");
+        }
+    }
+}

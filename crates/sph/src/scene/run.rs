@@ -425,7 +425,21 @@ fn finish(
     // Splash heights.
     if let Some(h) = &cfg.sensors.height {
         let x = h.reference_depth_m.unwrap_or(h.bin_m);
-        let span = h.window_s[1] - h.window_s[0];
+        // The plane counters are frozen when the window closes. A run that ends inside the window (before
+        // `window_s[1]`) reports what they counted up to its end, over the time it covered — as the volumes
+        // are; until 2026-11-24 it reported zero flux.
+        let [t0, t1] = h.window_s;
+        let closed = sim.time >= t1;
+        let (flux_up, flux_down, span) = if closed || !st.flux_started {
+            (&st.flux_up, &st.flux_down, t1 - t0)
+        } else {
+            log.line(&format!(
+                "splash heights: the run ended at t = {:.6} s inside the window [{t0}, {t1}] s; volumes and fluxes are averaged over [{t0}, {:.6}] s",
+                sim.time, sim.time
+            ))
+            .map_err(io_at(log_path))?;
+            (&sim.flux_up, &sim.flux_down, st.height_time)
+        };
         let mut rows = Vec::new();
         let mut vol_pts = Vec::new();
         let mut flux_pts = Vec::new();
@@ -433,8 +447,8 @@ fn finish(
             let lo = k as f64 * h.bin_m;
             let vol = if st.height_time > 0.0 { st.height_volume_time[k] / st.height_time } else { 0.0 };
             // Flux through the bin's lower edge.
-            let up = st.flux_up.get(k).copied().unwrap_or(0.0) / span;
-            let down = st.flux_down.get(k).copied().unwrap_or(0.0) / span;
+            let rate = |v: &Vec<f64>| if span > 0.0 { v.get(k).copied().unwrap_or(0.0) / span } else { 0.0 };
+            let (up, down) = (rate(flux_up), rate(flux_down));
             rows.push(vec![
                 spatter_io::fmt_f64(lo),
                 spatter_io::fmt_f64(lo + h.bin_m),
