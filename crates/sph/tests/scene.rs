@@ -162,6 +162,149 @@ fn column(cols: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
     rows.iter().map(|r| r[k]).collect()
 }
 
+/// Defaults of `[fluid]` (docs/sph.md §2): ρ₀ = 1000 kg/m³, g = 9.81 m/s², Tait γ = 7, c₀ = 10 U_max.
+const RHO0: f64 = 1000.0;
+const G: f64 = 9.81;
+
+/// Water at rest, 0.2 m deep, in a 2D tank 0.4 m wide whose side walls are parts of their own (blocks 4 dp
+/// thick reaching 4 dp below the floor, closing the corners), with a lid above the water that it never
+/// touches.
+const STILL: &str = r#"
+[fluid]
+dimensions = 2
+spacing_m = 0.01
+[[walls]]
+name = "floor"
+type = "tank"
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.4, 0.0, 0.3]
+open_faces = ["+z", "-x", "+x"]
+[[walls]]
+name = "left"
+type = "block"
+min_m = [-0.04, 0.0, -0.04]
+max_m = [0.0, 0.0, 0.3]
+[[walls]]
+name = "right"
+type = "block"
+min_m = [0.4, 0.0, -0.04]
+max_m = [0.44, 0.0, 0.3]
+[[walls]]
+name = "lid"
+type = "block"
+min_m = [0.1, 0.0, 0.26]
+max_m = [0.3, 0.0, 0.3]
+[[fill]]
+type = "box"
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.4, 0.0, 0.2]
+[output]
+end_time_s = 0.4
+vtu_interval_s = 0.2
+sample_interval_s = 0.005
+[sensors.height]
+base_z_m = 0.0
+bin_m = 0.03
+bins = 9
+window_s = [0.2, 0.4]
+"#;
+
+/// Still water (`STILL`): the side walls carry the hydrostatic force and moment, the height bins hold the
+/// water that is in them, no volume crosses a plane, the floor is wet for the whole run and the lid never.
+#[test]
+fn still_water_outputs_match_hydrostatics() {
+    let (depth, width, dp) = (0.2, 0.4, 0.01);
+    let cfg = config(STILL);
+    let tmp = tempfile::tempdir().unwrap();
+    run_to_end(&cfg, tmp.path());
+
+    // Loads (series.csv), averaged over the second half of the run, after the start-up transient.
+    let (cols, rows) = spatter_io::csv::read_series(&tmp.path().join("series.csv")).unwrap();
+    let t = column(&cols, &rows, "t_s");
+    let mean = |name: &str| {
+        let v: Vec<f64> = column(&cols, &rows, name)
+            .into_iter()
+            .zip(&t)
+            .filter(|(_, &t)| t >= 0.2)
+            .map(|(v, _)| v)
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    // Hydrostatics per metre of wall: force ½ρgH², moment about the wall's bottom edge ρgH³/6 (centre of
+    // pressure at H/3). Tolerance 1 %: the hydrostatic validation gets the wall pressure within about 1 %
+    // (measured here: force +0.22 %, moment +0.28 %).
+    let f_ref = 0.5 * RHO0 * G * depth * depth;
+    let m_ref = RHO0 * G * depth.powi(3) / 6.0;
+    // The torque is reported about the centroid of the part's particles (docs/sph.md §1, Loads): the
+    // centre of each block (its lattice is symmetric, the sides being whole multiples of dp), 2 cm outside
+    // the water's edge and 0.13 m above the floor.
+    for (side, sign, x_edge, x_centre) in [("left", -1.0, 0.0, -0.02), ("right", 1.0, width, width + 0.02)] {
+        let (fx, fz, my) =
+            (mean(&format!("{side}_Fx_N")), mean(&format!("{side}_Fz_N")), mean(&format!("{side}_My_Nm")));
+        // About the bottom edge e = (x_edge, 0, 0): M_e = M_c + (c − e) × F, its y component.
+        let m_edge = my + 0.13 * fx - (x_centre - x_edge) * fz;
+        assert!(
+            (fx - sign * f_ref).abs() < 0.01 * f_ref,
+            "{side}: Fx = {fx} N/m, hydrostatics {}",
+            sign * f_ref
+        );
+        assert!(
+            (m_edge - sign * m_ref).abs() < 0.01 * m_ref,
+            "{side}: moment about the bottom edge {m_edge} N m/m (about the centroid {my}), hydrostatics {}",
+            sign * m_ref
+        );
+        // In 2D every force and lever arm lies in the x–z plane: the other components are exactly 0.
+        for q in ["Fy_N", "Mx_Nm", "Mz_Nm"] {
+            assert!(column(&cols, &rows, &format!("{side}_{q}")).iter().all(|&v| v == 0.0), "{side}_{q}");
+        }
+    }
+    // The vertical loads of all parts add up to the weight of the water, within the 2 % of the hydrostatic
+    // validation (each side wall carries about 1 % of it: the floor within a kernel support of a corner).
+    let fz: f64 = ["floor", "left", "right", "lid"].iter().map(|p| mean(&format!("{p}_Fz_N"))).sum();
+    let weight = RHO0 * G * width * depth;
+    assert!((fz + weight).abs() < 0.02 * weight, "vertical load {fz} N/m, weight {weight} N/m");
+
+    // Height bins (splash_height.csv, 3 cm over the window 0.2–0.4 s): the tank's width times the height of
+    // water in the bin (2 of its 3 cm at the surface, none above), divided by the compression of the water,
+    // ρ/ρ₀ = (1 + γ g d/c₀²)^(1/γ) at the mid-depth d of the water in the bin (Tait, c₀ = 10 · 2√(gH) =
+    // 28 m/s: 0.23 % at the floor). Tolerance 0.1 % of a full bin: less than one particle (dp² is 0.83 % of
+    // it), so no particle may change bin.
+    let c0 = 10.0 * 2.0 * (G * depth).sqrt();
+    let bin = 0.03;
+    let (head, rows) = read_table(&tmp.path().join("splash_height.csv"));
+    assert_eq!(rows.len(), 9);
+    for row in &rows {
+        let (lo, hi) = (field(&head, row, "bin_low_m"), field(&head, row, "bin_high_m"));
+        let wet = (depth.min(hi) - lo).max(0.0);
+        let d = depth - (lo + 0.5 * wet);
+        let want = width * wet / (1.0 + 7.0 * G * d / (c0 * c0)).powf(1.0 / 7.0);
+        let vol = field(&head, row, "mean_volume_m3");
+        assert!((vol - want).abs() < 1e-3 * width * bin, "bin {lo}–{hi} m: {vol} m², expected {want} m²");
+        // No volume crosses a plane: both fluxes below one particle (dp²) over the 0.2 s window.
+        for q in ["upward_flux_lower_edge_m3_s", "net_flux_lower_edge_m3_s"] {
+            let f = field(&head, row, q);
+            assert!(f.abs() < dp * dp / 0.2, "bin {lo}–{hi} m: {q} = {f}");
+        }
+    }
+
+    // Wet times (wetting.csv).
+    let (head, rows) = read_table(&tmp.path().join("wetting.csv"));
+    let wall = |name: &str, q: &str| {
+        let row = rows.iter().find(|r| r[0] == name).unwrap_or_else(|| panic!("no row {name}"));
+        field(&head, row, q)
+    };
+    // The floor is under water at every step: its wet time is the sum of the same step lengths as the
+    // clock, so the fraction is 1 to round-off.
+    let floor = wall("floor", "mean_wet_fraction");
+    assert!((floor - 1.0).abs() < 1e-12, "floor wet fraction {floor}");
+    assert_eq!(wall("lid", "mean_wet_fraction"), 0.0, "the lid never meets the water");
+    // The side walls are wet over the water depth for the whole run, to one wall particle (dp).
+    for side in ["left", "right"] {
+        let a = wall(side, "mean_wet_area_m2");
+        assert!((a - depth).abs() < dp, "{side}: time-averaged wet length {a} m, water depth {depth} m");
+    }
+}
+
 /// Two slabs of water in zero gravity: A, 0.2 m wide, z ∈ [0, 0.2] m at t = 0, moving up at 0.4 m/s, and B,
 /// 0.1 m wide, z ∈ [0.2, 0.4] m, moving down at 0.4 m/s, 0.3 m apart. At the rest density nothing acts on
 /// them: they move rigidly (exactly: every pair has zero pressure and relative velocity).
