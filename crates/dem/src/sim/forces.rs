@@ -7,14 +7,18 @@ use crate::par::{run_groups, Group};
 use crate::walls::mesh::HitBuffer;
 use crate::walls::{WallHit, WallKinematics, WallShape};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use spatter_core::Vec3;
 
-/// What one wall-candidate slot did in the last evaluation.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// What one wall-candidate slot did in the last evaluation. `active` is also the slot's contact flag: a
+/// contact *forms* (counts as an impact in the mesh records) in an evaluation where its slot was not
+/// active in the previous one, whatever the contact law keeps as state (a stateless law's state always
+/// equals its default). Carried over list rebuilds and seams with the state, and checkpointed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SlotOut {
     /// In contact in the last evaluation.
     pub active: bool,
-    /// The contact formed in the last evaluation.
+    /// The contact formed in the last evaluation (the slot was not active in the one before).
     pub formed: bool,
     /// Signed normal force F_n \[N\] (the tangential magnitude is √(|F|² − F_n²)).
     pub normal_force: f64,
@@ -196,7 +200,7 @@ impl<L: ContactLaw> Simulation<L> {
                                 w_rel: omega[i] - kw.omega,
                                 dt,
                             };
-                            let was_new = *state == default;
+                            let was_new = !out.active;
                             match law.compute(pp, &c, state) {
                                 None => {
                                     *state = default;
@@ -224,16 +228,17 @@ impl<L: ContactLaw> Simulation<L> {
                             m.resolve(x_ref, reach, &w_tri[k..e], &mut raw, &mut hits);
                             let hs = hits.as_slice();
                             let accepted = |s: usize| hs.iter().any(|h| k + h.slot == s);
-                            // A contact that moved onto a neighbouring triangle inherits the state of
-                            // the nearest contact of this mesh that ended.
+                            // A contact that moved onto a neighbouring triangle inherits the state and
+                            // the activity (it is not a new impact) of the nearest contact of this mesh
+                            // that ended.
                             for h in hs {
                                 let s = k + h.slot;
-                                if states[s - sbase] != default {
+                                if outs[s - sbase].active {
                                     continue;
                                 }
                                 let mut best: Option<(f64, usize)> = None;
                                 for s2 in k..e {
-                                    if accepted(s2) || states[s2 - sbase] == default {
+                                    if accepted(s2) || !outs[s2 - sbase].active {
                                         continue;
                                     }
                                     let [a, b, c] = m.mesh.corners(w_tri[s2] as usize);
@@ -247,6 +252,8 @@ impl<L: ContactLaw> Simulation<L> {
                                 if let Some((_, s2)) = best {
                                     states[s - sbase] = states[s2 - sbase];
                                     states[s2 - sbase] = default;
+                                    outs[s - sbase] = outs[s2 - sbase];
+                                    outs[s2 - sbase] = SlotOut::default();
                                 }
                             }
                             for s in k..e {

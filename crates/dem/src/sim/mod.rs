@@ -407,8 +407,10 @@ impl<L: ContactLaw> Simulation<L> {
         self.evaluated_ids = self.particles.next_id();
         self.st = s.dynamic;
         let n = self.st.wall_list.state.len();
-        self.st.wall_list.out.clear();
-        self.st.wall_list.out.resize(n, forces::SlotOut::default());
+        if self.st.wall_list.out.len() != n {
+            self.st.wall_list.out.clear();
+            self.st.wall_list.out.resize(n, forces::SlotOut::default());
+        }
         Ok(())
     }
 

@@ -1,5 +1,5 @@
 //! Neighbour and wall-candidate lists: rebuilt with a skin, particles re-sorted by cell at every rebuild,
-//! contact states carried over by stable ids.
+//! contact states (and for wall slots their contact flags) carried over by stable ids.
 
 use super::forces::SlotOut;
 use super::Simulation;
@@ -35,8 +35,8 @@ pub struct WallList<S> {
     pub wall: Vec<u16>,
     pub tri: Vec<u32>,
     pub state: Vec<S>,
-    /// What each slot did in the last evaluation (not checkpointed; rebuilt on load).
-    #[serde(skip)]
+    /// What each slot did in the last evaluation; its `active` flag tells a new contact from a
+    /// continuing one, so it is carried over rebuilds and checkpointed with the state.
     pub out: Vec<SlotOut>,
     /// Particle blocks for the parallel wall loop.
     pub blocks: Vec<Group>,
@@ -82,15 +82,18 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         carry.sort_unstable_by_key(|c| c.0);
-        let mut wall_carry: Vec<((u32, u16, u32), L::State)> = Vec::new();
+        // (particle id, wall, triangle), state and last output of every slot in contact.
+        type WallCarry<S> = ((u32, u16, u32), S, SlotOut);
+        let mut wall_carry: Vec<WallCarry<L::State>> = Vec::new();
         {
             let p = &self.particles;
             let wl = &self.st.wall_list;
             if wl.start.len() == p.len() + 1 {
+                let out = |k: usize| wl.out.get(k).copied().unwrap_or_default();
                 for i in 0..p.len() {
                     for k in wl.start[i] as usize..wl.start[i + 1] as usize {
-                        if wl.state[k] != default {
-                            wall_carry.push(((p.id[i], wl.wall[k], wl.tri[k]), wl.state[k]));
+                        if wl.state[k] != default || out(k).active {
+                            wall_carry.push(((p.id[i], wl.wall[k], wl.tri[k]), wl.state[k], out(k)));
                         }
                     }
                 }
@@ -278,6 +281,7 @@ impl<L: ContactLaw> Simulation<L> {
                     let key = (p.id[i], wl.wall[k], wl.tri[k]);
                     if let Ok(m) = wall_carry.binary_search_by_key(&key, |c| c.0) {
                         wl.state[k] = wall_carry[m].1;
+                        wl.out[k] = wall_carry[m].2;
                     }
                 }
             }

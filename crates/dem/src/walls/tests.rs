@@ -2,7 +2,9 @@
 //! shared vertex; mesh contact rules on convex and concave corners.
 
 use super::*;
-use crate::contact::HertzMindlin;
+use crate::contact::{
+    Composed, ContactLaw, Frictionless, Hertz, HertzMindlin, NoRolling, RestitutionDamping,
+};
 use crate::particles::NewParticle;
 use crate::sim::{uniform_pairs, Settings, Simulation};
 use spatter_core::material::Material;
@@ -184,13 +186,24 @@ fn a_sphere_bounces_off_a_rectangle_misses_it_outside_and_is_deflected_by_its_ed
 /// two-triangle STL square as floor, optionally under a rigid analytic ceiling at height `ceiling`, no
 /// gravity.
 fn on_stl_floor(dir: &Path, x0: Vec3, v0: Vec3, ceiling: Option<f64>) -> Simulation<HertzMindlin> {
+    on_stl_floor_with(HertzMindlin::default(), dir, x0, v0, ceiling)
+}
+
+/// [`on_stl_floor`] with contact law `law`.
+fn on_stl_floor_with<L: ContactLaw>(
+    law: L,
+    dir: &Path,
+    x0: Vec3,
+    v0: Vec3,
+    ceiling: Option<f64>,
+) -> Simulation<L> {
     let al = Material::new(70e9, 0.3, 2699.0).unwrap();
     let mats = vec![al.clone(), Material::new(f64::INFINITY, 0.3, 2699.0).unwrap()];
     let pairs = uniform_pairs(&mats, 0.3, 0.8);
     let r = 0.01;
     let m = 2699.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     let tc = spatter_core::timestep::hertz_time(m, r, pairs.get(0, 1).e_star, 1.0);
-    let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, tc / 200.0, Settings::default());
+    let mut sim = Simulation::new(law, mats, pairs, tc / 200.0, Settings::default());
     let floor = WallShape::Mesh(Box::new(MeshWall::new(two_triangle_square(dir))));
     sim.add_wall(Wall { name: "floor".into(), shape: floor, material: 1, motion: Motion::Fixed });
     if let Some(h) = ceiling {
@@ -203,7 +216,7 @@ fn on_stl_floor(dir: &Path, x0: Vec3, v0: Vec3, ceiling: Option<f64>) -> Simulat
     sim
 }
 
-fn floor_records<L: crate::contact::ContactLaw>(sim: &Simulation<L>) -> &MeshRecords {
+fn floor_records<L: ContactLaw>(sim: &Simulation<L>) -> &MeshRecords {
     match &sim.walls[0].shape {
         WallShape::Mesh(m) => &m.records,
         _ => unreachable!("wall 0 is the STL floor"),
@@ -279,4 +292,115 @@ fn stl_impact_records_equal_the_momentum_change_and_count_each_impact_once() {
     assert!((jn / expect - 1.0).abs() < 1e-9, "normal impulse {jn} vs {expect}");
     let speeds: f64 = rec.impact_speed_sum.iter().sum();
     assert!((speeds - (1.0 - free[2])).abs() < 1e-12, "impact speeds {speeds} vs 1 + {}", -free[2]);
+}
+
+/// Hertz with restitution damping and no friction: a law whose contacts keep no state at all.
+type Stateless = Composed<Hertz, RestitutionDamping, Frictionless, NoRolling>;
+
+#[test]
+fn a_contact_of_a_stateless_law_is_one_impact_however_long_it_lasts() {
+    // A contact forms when its wall slot was not in contact in the previous evaluation, not when the
+    // law's state equals its default (which a stateless law's always does). Head-on bounces at 1 m/s
+    // on the two-triangle STL (face point, shared edge, shared vertex; ~200 steps in contact) are one
+    // impact each, with the approach speed 1 m/s (1e-12) and Σ|F_n|Δt = m (v_in + v_out) (1e-9, as
+    // for Hertz–Mindlin above); two bounces under a ceiling are two.
+    let law = Stateless::default();
+    assert_eq!(<Stateless as ContactLaw>::State::default(), Default::default());
+    let dir = tempfile::tempdir().unwrap();
+    let r = 0.01;
+    let h = r + 1e-5;
+    for (name, xy) in [("face", (0.7, 0.25)), ("edge", (0.5, 0.5)), ("vertex", (0.0, 0.0))] {
+        let v0 = Vec3::new(0.0, 0.0, -1.0);
+        let mut sim = on_stl_floor_with(law, dir.path(), Vec3::new(xy.0, xy.1, h), v0, None);
+        sim.run_steps(600).unwrap();
+        let m = 1.0 / sim.particles.inv_mass[0];
+        let v1 = sim.particles.vel[0];
+        assert!(v1.z > 0.5 && sim.last_evaluation().wall_contacts == 0, "{name}: bounced ({v1})");
+        let rec = floor_records(&sim);
+        assert_eq!(rec.impacts.iter().sum::<u64>(), 1, "{name}: impacts per triangle {:?}", rec.impacts);
+        let speed: f64 = rec.impact_speed_sum.iter().sum();
+        assert!((speed - 1.0).abs() < 1e-12, "{name}: impact speed {speed}");
+        let jn: f64 = rec.normal_impulse.iter().sum();
+        assert!((jn / (m * (v1.z - v0.z)) - 1.0).abs() < 1e-9, "{name}: normal impulse {jn}");
+    }
+    let mut sim = on_stl_floor_with(
+        law,
+        dir.path(),
+        Vec3::new(0.5, 0.5, h),
+        Vec3::new(0.0, 0.0, -1.0),
+        Some(2.0 * r + 1e-4),
+    );
+    let mut ups = 0;
+    let mut was_up = false;
+    for _ in 0..20_000 {
+        sim.step().unwrap();
+        let up = sim.particles.vel[0].z > 0.0 && sim.last_evaluation().wall_contacts == 0;
+        ups += (up && !was_up) as u32;
+        was_up = up;
+        if ups == 2 {
+            break;
+        }
+    }
+    assert_eq!(ups, 2, "two floor bounces");
+    assert_eq!(floor_records(&sim).impacts.iter().sum::<u64>(), 2, "{:?}", floor_records(&sim).impacts);
+}
+
+/// A soft sphere (E = 50 MPa, r = 1 cm) resting under gravity at its static Hertz overlap on the
+/// two-triangle STL, at (0.45, 0.5), sliding at 1 m/s along x across the shared diagonal (x = y), Δt = 20 µs.
+fn resting_slider<L: ContactLaw>(law: L, dir: &Path) -> Simulation<L> {
+    let soft = Material::new(5e7, 0.3, 2500.0).unwrap();
+    let mats = vec![soft];
+    let pairs = uniform_pairs(&mats, 0.5, 0.5);
+    let mut sim = Simulation::new(law, mats, pairs.clone(), 2e-5, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    let floor = WallShape::Mesh(Box::new(MeshWall::new(two_triangle_square(dir))));
+    sim.add_wall(Wall { name: "floor".into(), shape: floor, material: 0, motion: Motion::Fixed });
+    let r = 0.01;
+    let m = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let delta = (3.0 * m * 9.81 / (4.0 * pairs.get(0, 0).e_star * r.sqrt())).powf(2.0 / 3.0);
+    let mut p = NewParticle::at(Vec3::new(0.45, 0.5, r - delta), r, 0);
+    p.vel = Vec3::new(1.0, 0.0, 0.0);
+    sim.add_particle(p);
+    sim
+}
+
+#[test]
+fn a_contact_sliding_across_a_seam_through_rebuilds_and_a_checkpoint_is_one_impact() {
+    // The resting slider of [`resting_slider`] stays in contact for 7500 steps (0.15 s, to x ≈ 0.6, or
+    // 0.565 for Hertz–Mindlin, whose friction soon makes it roll at 5/7 of the speed; > 0.55 checked): it
+    // crosses from one triangle to the other (both carry normal impulse), the lists are rebuilt every
+    // ~1 mm of travel (half the default skin of 10 % of the diameter), and the run is checkpointed
+    // (written and read back) and resumed half-way. Exactly one impact is recorded, for the stateless
+    // law as for Hertz–Mindlin, and the resumed run's records equal the uninterrupted run's bit for bit.
+    fn check<L: ContactLaw>(law: L, name: &str) {
+        let dir = tempfile::tempdir().unwrap();
+        let mut sim = resting_slider(law.clone(), dir.path());
+        sim.run_steps(3750).unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        spatter_io::checkpoint::save(&path, &sim.state()).unwrap();
+        sim.run_steps(3750).unwrap();
+        let mut resumed = resting_slider(law, dir.path());
+        resumed.restore(spatter_io::checkpoint::load(&path).unwrap()).unwrap();
+        resumed.run_steps(3750).unwrap();
+        for (run, s) in [("uninterrupted", &sim), ("resumed", &resumed)] {
+            assert!(
+                s.particles.pos[0].x > 0.55,
+                "{name} {run}: crossed the diagonal ({})",
+                s.particles.pos[0]
+            );
+            assert!(s.rebuild_count() > 20, "{name} {run}: lists rebuilt {} times", s.rebuild_count());
+            assert_eq!(s.last_evaluation().wall_contacts, 1, "{name} {run}: still in contact");
+            let rec = floor_records(s);
+            assert!(rec.normal_impulse.iter().all(|&j| j > 0.0), "{name} {run}: {:?}", rec.normal_impulse);
+            assert_eq!(
+                rec.impacts.iter().sum::<u64>(),
+                1,
+                "{name} {run}: impacts per triangle {:?}",
+                rec.impacts
+            );
+        }
+        assert_eq!(floor_records(&sim), floor_records(&resumed), "{name}: resumed records differ");
+    }
+    check(Stateless::default(), "stateless");
+    check(HertzMindlin::default(), "Hertz–Mindlin");
 }
