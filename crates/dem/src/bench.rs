@@ -2,11 +2,13 @@
 //!
 //! The case: monodisperse-ish spheres (radius 0.9995–1.0 mm, soft glass E = 50 MPa, ν = 0.3,
 //! ρ = 2500 kg/m³, μ = 0.5, e = 0.5) on a face-centred-cubic lattice filling a box of planes (floor and
-//! four sides), settled under gravity for a few hundred steps (untimed), then advanced for a fixed number
-//! of steps with 1 and with 2 threads from the same state. Printed: particle-steps per second for both
-//! thread counts, the parallel efficiency, the state bytes per particle (particles, neighbour list with
-//! contact histories, wall candidates; the cell grid lives only during rebuilds), and the Verlet-list versus every-step cell search
-//! comparison.
+//! four sides), settled under gravity for 4000 steps (untimed; 2000 in the quick box), then advanced for
+//! 400 steps (200) with 1 and with 2 threads from the same state. Printed: particle-steps per second for
+//! both thread counts, the parallel efficiency, the rates with the per-contact and without an energy
+//! budget, the state bytes per particle (particles, neighbour list with contact histories, wall
+//! candidates; the cell grid lives only during rebuilds), and the Verlet-list versus every-step cell
+//! search comparison (a quarter of the steps). The comparison with LAMMPS (`bench/dem/compare.sh`) times
+//! whole runs of 1000 steps with the `dem_bench` example instead.
 //!
 //! [`write_lammps_data`] writes the settled state as a LAMMPS data file for `bench/dem/compare.sh`, which
 //! runs the same case in LAMMPS (`pair_style granular hertz/material … tangential mindlin`).
