@@ -30,6 +30,7 @@ pub mod motion;
 pub mod regime;
 pub mod rng;
 pub mod shapes;
+pub mod special;
 pub mod surface_sample;
 pub mod timestep;
 pub mod tri_bvh;

@@ -14,7 +14,7 @@ pub mod decompose;
 pub mod dispersion;
 pub mod imported;
 pub mod rotor;
-pub mod special;
+pub use spatter_core::special;
 pub mod tetmesh;
 pub mod wall_jet;
 

@@ -1,4 +1,4 @@
-//! Special functions needed by the analytic fields and tests.
+//! Special functions (error function) for the analytic flow fields, the size distributions and tests.
 
 /// Error function, |error| < 1.2 × 10⁻⁷ everywhere: the Chebyshev-fitted complementary error function of
 /// Press et al., *Numerical Recipes* 2nd ed. (1992), §6.2 `erfcc`.
