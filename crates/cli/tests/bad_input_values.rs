@@ -57,7 +57,13 @@ fn wrong_type() {
 #[test]
 fn missing_key() {
     let text = edited("density_kg_m3 = 920.0\n", "");
-    rejects("missing.toml", text.as_bytes(), &["missing.toml:", "missing field `density_kg_m3`"]);
+    // Located at the table that lacks the key.
+    let l = line_of(&text, "[particle]");
+    rejects(
+        "missing.toml",
+        text.as_bytes(),
+        &[&format!("missing.toml:{l}:1"), "key `particle`", "missing field `density_kg_m3`"],
+    );
 }
 
 #[test]
