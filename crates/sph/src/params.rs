@@ -61,10 +61,17 @@ pub struct SphParams {
     pub drag: DragParams,
     /// Particles whose density leaves `[lo, hi]·ρ₀` are removed and counted. Default [0.7, 1.3].
     pub density_window: [f64; 2],
-    /// A boundary particle is wet while a fluid particle is within this distance \[m\] of the surface point
-    /// it stands for (dp/2 in front of a lattice or solid wall particle; a shell sample itself, with the
-    /// distance grown by dp, `Sampling::wet_reach`). Default 1.0·dp.
+    /// Wet criterion, normal reach \[m\]: a boundary particle is wet while a fluid particle lies within this
+    /// distance of the surface point it stands for *along the surface normal* (either side) and within
+    /// [`SphParams::wet_lateral`] of it along the surface. The surface point is dp/2 in front of a lattice
+    /// or solid wall particle, a shell sample itself with the reach grown by dp
+    /// (`Sampling::wet_reach`). Default 1.5·dp: water that arrives at a wall rests 0.4–1.4 dp off it
+    /// (docs/sph.md §7).
     pub wet_distance: f64,
+    /// Wet criterion, lateral reach \[m\] along the surface (see [`SphParams::wet_distance`]). Default
+    /// 0.75·dp: the wall particle one row above a still water line (1 dp from the top fluid row along
+    /// the wall) stays dry, a particle of the patch a wall particle stands for (side dp) wets it.
+    pub wet_lateral: f64,
     /// A particle stopped at a wall it would have crossed is put back this far in front of it, as a
     /// fraction of dp. Default 0.2.
     pub guard_offset: f64,
@@ -95,7 +102,8 @@ impl SphParams {
             curvature_weight: 1.0,
             drag: DragParams::default(),
             density_window: [0.7, 1.3],
-            wet_distance: dp,
+            wet_distance: 1.5 * dp,
+            wet_lateral: 0.75 * dp,
             guard_offset: 0.2,
         }
     }

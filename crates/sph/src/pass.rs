@@ -165,8 +165,11 @@ pub(crate) struct Consts {
     pub eos_gamma: f64,
     pub eos: crate::eos::Tait,
     pub akinci: AkinciSplines,
-    /// Squared wet distance per part, the wet distance plus [`crate::boundary::Sampling::wet_reach`].
-    pub wet_d2: Vec<f64>,
+    /// Normal reach of the wet test per part \[m\]: the wet distance plus
+    /// [`crate::boundary::Sampling::wet_reach`].
+    pub wet_normal: Vec<f64>,
+    /// Squared lateral reach of the wet test \[m²\].
+    pub wet_lateral2: f64,
     /// Distance from a wall particle to the surface point it stands for, per part (dp/2 for lattice walls).
     pub wet_offset: Vec<f64>,
     pub slip_free: Vec<bool>,
@@ -260,15 +263,12 @@ pub(crate) fn wall_state(
                 for o in 0..rho_c.len() {
                     let b = ci * CHUNK + o;
                     let xb = wl.pos[b];
-                    // Wetness is judged from the point of the wall surface the particle stands for.
+                    // Wetness is judged from the point of the wall surface the particle stands for:
+                    // fluid within the normal reach across the surface and the lateral reach along it.
                     let part = wl.part[b] as usize;
-                    let wet_d2 = c.wet_d2[part];
-                    let xs = if c.wet_offset[part] > 0.0 {
-                        let f = &wl.frames[part];
-                        xb + f.rot * wl.ref_normal[wl.src[b] as usize] * c.wet_offset[part]
-                    } else {
-                        xb
-                    };
+                    let (wet_n, wet_t2) = (c.wet_normal[part], c.wet_lateral2);
+                    let normal = wl.frames[part].rot * wl.ref_normal[wl.src[b] as usize];
+                    let xs = xb + normal * c.wet_offset[part];
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
                     let mut is_wet = false;
                     for set in [fl, gh] {
@@ -282,7 +282,9 @@ pub(crate) fn wall_state(
                                     spw += c.eos.pressure(set.rho[j]) * w;
                                     srx += dx * (set.rho[j] * w);
                                     svw += set.vel[j] * w;
-                                    is_wet |= (xs - set.pos[j]).length_squared() < wet_d2;
+                                    let d = set.pos[j] - xs;
+                                    let dn = d.dot(normal);
+                                    is_wet |= dn.abs() < wet_n && d.length_squared() - dn * dn < wet_t2;
                                 }
                             }
                         });

@@ -447,12 +447,13 @@ impl Simulation {
             eos_gamma: p.gamma,
             eos,
             akinci: crate::kernel::AkinciSplines::new(support),
-            wet_d2: self
+            wet_normal: self
                 .boundary
                 .parts
                 .iter()
-                .map(|q| (p.wet_distance + q.sampling.wet_reach(p.spacing)).powi(2))
+                .map(|q| p.wet_distance + q.sampling.wet_reach(p.spacing))
                 .collect(),
+            wet_lateral2: p.wet_lateral * p.wet_lateral,
             wet_offset: self.boundary.parts.iter().map(|q| q.sampling.surface_offset(p.spacing)).collect(),
             slip_free: self.boundary.parts.iter().map(|q| q.slip == Slip::FreeSlip).collect(),
         }

@@ -473,12 +473,11 @@ fn wet_time_is_the_time_under_water() {
             assert!((wet[i] - elapsed).abs() < 1e-12, "z0 = {z0}: wet {} s of {elapsed} s", wet[i]);
             submerged += 1;
         } else {
-            // Reaches the water line when it is within the wet distance dp of the top fluid row (dp/2 below
-            // the surface and dp/2 from the wall): √(dp² − (dp/2)²) above the row. Tolerance: the water line
-            // is resolved to one particle spacing, dp/v = 0.1 s of the wall's travel (measured: 0.002 s
-            // late for the first particle, 0.06–0.07 s for the next ones: the wall coming down beside the
-            // free surface pushes the top fluid row next to it about 0.7 dp down, docs/sph.md §7).
-            let t_reach = (z0 - (depth - 0.5 * dp) - (0.75f64).sqrt() * dp) / v;
+            // Reaches the water line when the top fluid row (dp/2 below the surface, dp/2 from the wall,
+            // within the normal reach 1.5 dp) comes within the lateral reach 0.75 dp along the wall.
+            // Tolerance: the water line is resolved to one particle spacing, dp/v = 0.1 s of the wall's
+            // travel.
+            let t_reach = (z0 - (depth - 0.5 * dp) - 0.75 * dp) / v;
             let want = (elapsed - t_reach).max(0.0);
             assert!((wet[i] - want).abs() < dp / v, "z0 = {z0}: wet {} s, expected {want} s", wet[i]);
             if want > 0.0 {

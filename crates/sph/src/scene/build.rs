@@ -55,7 +55,8 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
     p.curvature_weight = f.curvature_weight;
     p.density_window = f.density_window;
     p.guard_offset = f.guard_offset;
-    p.wet_distance = cfg.sensors.wet_distance_m.unwrap_or(dp);
+    p.wet_distance = cfg.sensors.wet_distance_m.unwrap_or(p.wet_distance);
+    p.wet_lateral = cfg.sensors.wet_lateral_m.unwrap_or(p.wet_lateral);
     p.drag = DragParams {
         enabled: cfg.drag.enabled,
         air_density: cfg.drag.air_density_kg_m3,

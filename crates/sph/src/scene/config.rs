@@ -355,10 +355,14 @@ pub struct HeightConfig {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorConfig {
-    /// A wall particle is wet while fluid is within this distance \[m\] of the surface it stands for
-    /// (default: dp; shells reach dp further, `Sampling::wet_reach`).
+    /// Wet criterion, normal reach \[m\]: a wall particle is wet while fluid lies within this distance of
+    /// the surface point it stands for across the surface (default: 1.5 dp; shells reach dp further,
+    /// `Sampling::wet_reach`) and within `wet_lateral_m` along it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wet_distance_m: Option<f64>,
+    /// Wet criterion, lateral reach \[m\] along the surface (default: 0.75 dp).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wet_lateral_m: Option<f64>,
     #[serde(default)]
     pub probes: Vec<ProbeConfig>,
     #[serde(default)]
@@ -561,6 +565,9 @@ impl Validate for SphConfig {
             let s = &self.sensors;
             if let Some(d) = s.wet_distance_m {
                 c.positive("wet_distance_m", d);
+            }
+            if let Some(d) = s.wet_lateral_m {
+                c.positive("wet_lateral_m", d);
             }
             for (i, p) in s.probes.iter().enumerate() {
                 c.element("probes", i, |c| c.finite_vec("position_m", p.position_m));
