@@ -316,92 +316,111 @@ impl<L: ContactLaw> Simulation<L> {
             }
             m
         };
-        // Two stages per particle i: first the geometry of all its touching neighbours (short, independent
-        // iterations whose square roots and divisions overlap in the CPU), then the contact law for each.
+        // Two stages per chunk of up to BUF neighbours of particle i: first the geometry of the touching ones
+        // (short, independent iterations whose square roots and divisions overlap in the CPU), then the
+        // contact law for each.
         const BUF: usize = 16;
+        /// A touching pair found in stage 1. The law sees it from particle a (the lower id of i and j, so
+        /// that each state stays in one frame): `sign` is +1 when a = i, −1 when a = j, and turns the
+        /// geometry seen from i into a's exactly (negation is exact).
         #[derive(Clone, Copy, Default)]
         struct Candidate {
-            k: usize,
-            a: usize,
-            b: usize,
+            /// Slot of the pair within the chunk.
+            slot: usize,
+            /// The partner of i.
+            j: usize,
+            sign: f64,
+            /// Flat pair-type index.
             pair: usize,
-            c: ContactInput,
+            /// Unit normal, from b to a.
+            normal: Vec3,
+            /// Overlap δ \[m\].
+            overlap: f64,
+            /// R* \[m\].
+            r_eff: f64,
+            /// m* \[kg\].
+            m_eff: f64,
+            /// Contact-point velocity of a minus b's \[m/s\].
+            v_rel: Vec3,
         }
         let pair_work = |g: &Group,
                          pbase: usize,
                          (f, tq): (&mut [Vec3], &mut [Vec3]),
                          sbase: usize,
                          states: &mut [L::State]| {
+            // Re-sliced to one length: one bounds check per index covers every particle array.
+            let np = pos.len();
+            let (id, material, vel, omega, radius, inv_mass) =
+                (&id[..np], &material[..np], &vel[..np], &omega[..np], &radius[..np], &inv_mass[..np]);
+            let tq = &mut tq[..f.len()];
             let mut acc = Acc::default();
             let mut buf = [Candidate::default(); BUF];
             for i in g.work_begin as usize..g.work_end as usize {
-                let (mut k, k1) = (l_start[i] as usize, l_start[i + 1] as usize);
+                let (k0, k1) = (l_start[i] as usize, l_start[i + 1] as usize);
+                let (xi, ri, ii) = (pos[i], radius[i], inv_mass[i]);
                 // Force and torque on i are summed in registers and stored once.
                 let (mut fi, mut ti) = (Vec3::ZERO, Vec3::ZERO);
-                while k < k1 {
+                let slots = states[k0 - sbase..k1 - sbase].chunks_mut(BUF);
+                for (nbrs, slots) in l_nbr[k0..k1].chunks(BUF).zip(slots) {
                     let mut nbuf = 0;
-                    while k < k1 && nbuf < BUF {
-                        let e = l_nbr[k];
+                    for (slot, (&e, state)) in nbrs.iter().zip(slots.iter_mut()).enumerate() {
+                        // The cheapest test first, with i and j as they come.
                         let j = (e & super::neighbors::NBR_MASK) as usize;
-                        // Orientation by id (flagged in the list's top bit) keeps each state in the
-                        // lower-id particle's frame; branch-free, the id order is random.
-                        let swap = (e >> 31) as usize;
-                        let a = i ^ ((i ^ j) & swap.wrapping_neg());
-                        let b = i ^ j ^ a;
-                        let d = pos[a] - pos[b];
-                        let (ra, rb) = (radius[a], radius[b]);
-                        let rs = ra + rb;
+                        let d = xi - pos[j];
+                        let rj = radius[j];
+                        let rs = ri + rj;
                         let reach = rs + range_quick;
                         let dist2 = d.length_squared();
                         if dist2 >= reach * reach {
-                            let state = &mut states[k - sbase];
-                            if *state != default {
-                                *state = default;
-                            }
-                            k += 1;
+                            // A store is cheaper than comparing the state with the default.
+                            *state = default;
                             continue;
                         }
+                        // Orientation by id (flagged in the list's top bit); branch-free, the id order is
+                        // random.
+                        let sign = [1.0, -1.0][(e >> 31) as usize];
                         let dist = dist2.sqrt();
-                        let n = if dist > 0.0 { d * (1.0 / dist) } else { Vec3::Z };
-                        // One division for both R* = ra rb/(ra + rb) and m* = 1/(1/ma + 1/mb).
-                        let inv = inv_mass[a] + inv_mass[b];
+                        let n = if dist > 0.0 { d * (1.0 / dist) } else { sign * Vec3::Z };
+                        // One division for both R* = ri rj/(ri + rj) and m* = 1/(1/mi + 1/mj).
+                        let inv = ii + inv_mass[j];
                         let q = 1.0 / (rs * inv);
+                        buf[nbuf] = Candidate {
+                            slot,
+                            j,
+                            sign,
+                            pair: params.flat(material[i] as usize, material[j] as usize),
+                            normal: sign * n,
+                            overlap: rs - dist,
+                            r_eff: ri * rj * inv * q,
+                            m_eff: rs * q,
+                            v_rel: sign * (vel[i] - vel[j] - (ri * omega[i] + rj * omega[j]).cross(n)),
+                        };
+                        nbuf += 1;
+                    }
+                    for cand in &buf[..nbuf] {
+                        let (j, s) = (cand.j, cand.sign);
+                        let rj = radius[j];
                         let (i_eff, w_rel) = if L::USES_ROTATION {
-                            let inv_i = 2.5 * (inv_mass[a] / (ra * ra) + inv_mass[b] / (rb * rb));
-                            (1.0 / inv_i, omega[a] - omega[b])
+                            let inv_i = 2.5 * (ii / (ri * ri) + inv_mass[j] / (rj * rj));
+                            (1.0 / inv_i, s * (omega[i] - omega[j]))
                         } else {
                             (0.0, Vec3::ZERO)
                         };
-                        buf[nbuf] = Candidate {
-                            k,
-                            a,
-                            b,
-                            pair: params.flat(material[a] as usize, material[b] as usize),
-                            c: ContactInput {
-                                normal: n,
-                                overlap: rs - dist,
-                                r_eff: ra * rb * inv * q,
-                                m_eff: rs * q,
-                                i_eff,
-                                v_rel: vel[a] - vel[b] - (ra * omega[a] + rb * omega[b]).cross(n),
-                                w_rel,
-                                dt,
-                            },
+                        let c = ContactInput {
+                            normal: cand.normal,
+                            overlap: cand.overlap,
+                            r_eff: cand.r_eff,
+                            m_eff: cand.m_eff,
+                            i_eff,
+                            v_rel: cand.v_rel,
+                            w_rel,
+                            dt,
                         };
-                        nbuf += 1;
-                        k += 1;
-                    }
-                    for cand in &buf[..nbuf] {
-                        let (a, b, c) = (cand.a, cand.b, &cand.c);
-                        let state = &mut states[cand.k - sbase];
-                        let pp = params.at(cand.pair);
-                        match law.compute(pp, c, state) {
+                        let state = &mut slots[cand.slot];
+                        match law.compute(params.at(cand.pair), &c, state) {
                             None => *state = default,
                             Some(o) => {
-                                let (ra, rb) = (radius[a], radius[b]);
-                                // The force acts on a; i is a or b.
-                                let (j, s, ri, rj) =
-                                    if a == i { (b, 1.0, ra, rb) } else { (a, -1.0, rb, ra) };
+                                // The force acts on a, which is i for s = 1 and j for s = −1.
                                 let fv = o.force;
                                 let cr = c.normal.cross(fv);
                                 fi += s * fv;
@@ -411,8 +430,9 @@ impl<L: ContactLaw> Simulation<L> {
                                 acc.dissipated += o.dissipated;
                                 acc.elastic += o.energy;
                                 acc.pair_contacts += 1;
-                                let rmin = ra.min(rb);
+                                let rmin = ri.min(rj);
                                 if c.overlap > acc.max_ratio * rmin {
+                                    let (a, b) = if s > 0.0 { (i, j) } else { (j, i) };
                                     acc.note_overlap(c.overlap / rmin, id[a], id[b]);
                                 }
                             }
