@@ -146,8 +146,9 @@ pub trait ContactLaw: Clone + Send + Sync + 'static {
     /// Per-contact persistent state; `Default` means "no contact".
     type State: Copy + Default + PartialEq + Debug + Send + Sync + Serialize + DeserializeOwned;
 
-    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`] (rolling resistance). When
-    /// false the engine may leave them zero and skip computing them.
+    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`] and exerts a rolling
+    /// torque (rolling resistance). When false the engine may leave them zero and skip computing them, and
+    /// [`ContactOutput::rolling_torque`] must be zero (the engine then does not add it).
     const USES_ROTATION: bool = true;
 
     /// Precomputes the parameters of pair type `pair_index` (index into the engine's pair table).

@@ -20,7 +20,8 @@ pub trait RollingLaw: Clone + Debug + Send + Sync + 'static {
     type Params: Clone + Debug + Send + Sync;
     type State: Copy + Default + PartialEq + Debug + Send + Sync + Serialize + DeserializeOwned;
 
-    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`].
+    /// Whether the law reads [`ContactInput::w_rel`] and [`ContactInput::i_eff`]; a law that does not
+    /// must return a zero torque (see [`super::ContactLaw::USES_ROTATION`]).
     const USES_ROTATION: bool = true;
 
     fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params;

@@ -421,16 +421,24 @@ impl<L: ContactLaw> Simulation<L> {
                             None => *state = default,
                             Some(o) => {
                                 // The force acts on a, which is i for s = 1 and j for s = −1.
-                                let fv = o.force;
-                                let cr = c.normal.cross(fv);
-                                fi += s * fv;
-                                ti += s * o.rolling_torque - ri * cr;
-                                f[j - pbase] -= s * fv;
-                                tq[j - pbase] += -s * o.rolling_torque - rj * cr;
+                                let fv = s * o.force;
+                                let cr = c.normal.cross(o.force);
+                                fi += fv;
+                                f[j - pbase] -= fv;
+                                if L::USES_ROTATION {
+                                    let rt = s * o.rolling_torque;
+                                    ti += rt - ri * cr;
+                                    tq[j - pbase] -= rt + rj * cr;
+                                } else {
+                                    // No rolling torque (see `ContactLaw::USES_ROTATION`).
+                                    ti -= ri * cr;
+                                    tq[j - pbase] -= rj * cr;
+                                }
                                 acc.dissipated += o.dissipated;
                                 acc.elastic += o.energy;
                                 acc.pair_contacts += 1;
-                                let rmin = ri.min(rj);
+                                // Radii are positive: a compare is enough (no NaN handling).
+                                let rmin = if ri < rj { ri } else { rj };
                                 if c.overlap > acc.max_ratio * rmin {
                                     let (a, b) = if s > 0.0 { (i, j) } else { (j, i) };
                                     acc.note_overlap(c.overlap / rmin, id[a], id[b]);

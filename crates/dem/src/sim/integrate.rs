@@ -43,28 +43,33 @@ impl<L: ContactLaw> Simulation<L> {
             .enumerate()
             .map(|(c, (((vs, ws), xs), (fs, ts)))| {
                 let base = c * CHUNK;
+                let (inv_m, radius) = (&inv_m[base..base + vs.len()], &radius[base..base + vs.len()]);
                 let mut m: f64 = 0.0;
-                // Sum of squares: NaN or ∞ anywhere propagates to it (f64::max would hide a NaN).
+                // Sum of all components: NaN or ∞ anywhere makes it non-finite (f64::max would hide a NaN;
+                // a finite sum that overflows only costs a search in `check_finite`).
                 let mut check = 0.0;
-                for (k, ((v, w), x)) in vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut()).enumerate() {
-                    let i = base + k;
+                let particles = vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut());
+                let inputs = fs.iter_mut().zip(ts.iter_mut()).zip(inv_m.iter().zip(radius));
+                for (k, (((v, w), x), ((f, t), (&im, &r)))) in particles.zip(inputs).enumerate() {
                     // Frozen particles have zero inverse mass and inertia: the kick vanishes.
-                    let hm = h * inv_m[i];
-                    *v += hm * fs[k];
+                    let hm = h * im;
+                    *v += hm * *f;
                     // 1/I = 2.5/(m r²).
-                    *w += (2.5 * hm / (radius[i] * radius[i])) * ts[k];
+                    *w += (2.5 * hm / (r * r)) * *t;
                     if drift {
                         *x += *v * dt;
                     }
                     let v2 = v.length_squared();
-                    m = m.max(v2);
-                    check += v2 + w.length_squared() + x.length_squared();
+                    if v2 > m {
+                        m = v2;
+                    }
+                    check += (*v + *w + *x).element_sum();
                     if reset {
-                        fs[k] = if inv_m[i] > 0.0 { g / inv_m[i] } else { Vec3::ZERO };
-                        ts[k] = Vec3::ZERO;
+                        *f = if im > 0.0 { g / im } else { Vec3::ZERO };
+                        *t = Vec3::ZERO;
                         if has_ext {
-                            fs[k] += ext_f[i];
-                            ts[k] += ext_t[i];
+                            *f += ext_f[base + k];
+                            *t += ext_t[base + k];
                         }
                     }
                 }
