@@ -325,7 +325,7 @@ impl<L: ContactLaw> Simulation<L> {
         /// geometry seen from i into a's exactly (negation is exact).
         #[derive(Clone, Copy, Default)]
         struct Candidate {
-            /// Slot of the pair within the chunk.
+            /// Slot of the pair among i's neighbours.
             slot: usize,
             /// The partner of i.
             j: usize,
@@ -360,11 +360,15 @@ impl<L: ContactLaw> Simulation<L> {
                 let (xi, ri, ii) = (pos[i], radius[i], inv_mass[i]);
                 // Force and torque on i are summed in registers and stored once.
                 let (mut fi, mut ti) = (Vec3::ZERO, Vec3::ZERO);
-                let slots = states[k0 - sbase..k1 - sbase].chunks_mut(BUF);
-                for (nbrs, slots) in l_nbr[k0..k1].chunks(BUF).zip(slots) {
+                let nbrs = &l_nbr[k0..k1];
+                let slots = &mut states[k0 - sbase..][..nbrs.len()];
+                let mut c0 = 0;
+                while c0 < nbrs.len() {
+                    let c1 = nbrs.len().min(c0 + BUF);
                     let mut nbuf = 0;
-                    for (slot, (&e, state)) in nbrs.iter().zip(slots.iter_mut()).enumerate() {
+                    for slot in c0..c1 {
                         // The cheapest test first, with i and j as they come.
+                        let e = nbrs[slot];
                         let j = (e & super::neighbors::NBR_MASK) as usize;
                         let d = xi - pos[j];
                         let rj = radius[j];
@@ -373,7 +377,7 @@ impl<L: ContactLaw> Simulation<L> {
                         let dist2 = d.length_squared();
                         if dist2 >= reach * reach {
                             // A store is cheaper than comparing the state with the default.
-                            *state = default;
+                            slots[slot] = default;
                             continue;
                         }
                         // Orientation by id (flagged in the list's top bit); branch-free, the id order is
@@ -446,6 +450,7 @@ impl<L: ContactLaw> Simulation<L> {
                             }
                         }
                     }
+                    c0 = c1;
                 }
                 f[i - pbase] += fi;
                 tq[i - pbase] += ti;
