@@ -78,3 +78,61 @@ fn interrupted_and_resumed_run_equals_uninterrupted_run() {
         assert!(a == b, "{f} differs between the uninterrupted and the resumed run");
     }
 }
+
+/// A real Ctrl-C (SIGINT sent to the process while it runs, at a moment the test does not choose
+/// exactly) stops the hopper example cleanly with exit code 130 and a checkpoint; `--resume` finishes
+/// it, and every output equals that of the uninterrupted run byte for byte.
+#[cfg(unix)]
+#[test]
+fn a_real_ctrl_c_interrupts_and_the_run_resumes_to_the_same_results() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let text =
+        include_str!("../../../examples/dem_hopper.toml").replace("duration_s = 1.5", "duration_s = 0.2");
+    assert!(text.contains("duration_s = 0.2"));
+    let scenario = write(dir.path(), "hopper.toml", text.as_bytes());
+    write(dir.path(), "dem_hopper.stl", include_bytes!("../../../examples/dem_hopper.stl"));
+    let (whole, parts) = (dir.path().join("whole"), dir.path().join("parts"));
+    let command = |out: &Path, extra: &[&str]| {
+        let mut c = spatter();
+        c.arg("run").arg(&scenario).arg("--out").arg(out).args(extra).env("SPATTER_NO_PROGRESS", "1");
+        c
+    };
+    let o = command(&whole, &[]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // Interrupt once the third particle file (t = 0.04 s of 0.2 s) is written: the CSV tables are
+    // buffered until the run stops, the per-output VTU files are not.
+    let mut child = command(&parts, &[]).stdout(std::process::Stdio::null()).spawn().unwrap();
+    let start = Instant::now();
+    loop {
+        let written = std::fs::read_dir(parts.join("particles")).map(|d| d.count()).unwrap_or(0);
+        if written >= 3 {
+            break;
+        }
+        assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
+        assert!(start.elapsed() < Duration::from_secs(600), "no particle files written");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill").arg("-INT").arg(child.id().to_string()).status().unwrap();
+    assert!(kill.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "a Ctrl-C'd run exits 130");
+    assert!(parts.join("checkpoint.bin").is_file(), "the interruption leaves a checkpoint");
+
+    let o = command(&parts, &["--resume"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!parts.join("checkpoint.bin").exists(), "a finished run removes its checkpoint");
+    for f in ["energy.csv", "particles.pvd", "hopper_wall.pvd"] {
+        let (a, b) = (std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap());
+        assert!(a == b, "{f} differs between the uninterrupted and the resumed run");
+    }
+    let vtus = files(&whole.join("particles"));
+    assert_eq!(vtus, files(&parts.join("particles")));
+    let last = vtus.last().unwrap();
+    let (a, b) = (
+        std::fs::read(whole.join("particles").join(last)).unwrap(),
+        std::fs::read(parts.join("particles").join(last)).unwrap(),
+    );
+    assert!(a == b, "the last particle file {last} differs");
+}
