@@ -44,8 +44,10 @@ impl NeighbourGrid {
     }
 
     /// Cells a query reaches beyond its own along each axis: `ceil(support / cell size)`.
+    #[inline]
     fn reach_cells(&self) -> usize {
-        (self.support / self.cells.cell_size()).ceil() as usize
+        // ceil(x) = −floor(−x), without the libm call of `f64::ceil` on baseline x86-64.
+        -floor(-self.support / self.cells.cell_size()) as usize
     }
 
     /// Marks the cells from which a query can find a point (occupancy dilated by the query reach), so
@@ -168,14 +170,22 @@ impl NeighbourGrid {
         let inv = 1.0 / self.cells.cell_size();
         let q = (p - self.cells.origin()) * inv;
         let r = self.support * inv;
+        // Cells are at least half the support (the grid only ever enlarges them), so a query reaches
+        // at most two cells beyond its own along each axis.
+        debug_assert!(r <= 2.0 + 1e-9, "query reach {r} cells");
         let [nx, ny, nz] = self.cells.dims();
+        // Own cell of p, possibly outside the grid; a query from beyond two cells of it finds nothing
+        // (nor does a NaN point: every comparison below is then false).
+        let (cx, cy, cz) = (floor(q.x), floor(q.y), floor(q.z));
+        let near = |c: f64, n: usize, reach: f64| c >= -reach && c <= (n - 1) as f64 + reach;
+        if !(near(cx, nx, 2.0) && near(cy, ny, 2.0) && near(cz, nz, 2.0)) {
+            return;
+        }
         if !after && !self.reach.is_empty() {
-            // Own cell of p, possibly outside the grid: a query from beyond `reach` cells finds nothing;
-            // otherwise the flag of the nearest grid cell covers its whole stencil.
+            // Beyond `reach` cells nothing is found; otherwise the flag of the nearest grid cell covers
+            // the whole stencil.
             let rc = self.reach_cells() as f64;
-            let (cx, cy, cz) = (floor(q.x), floor(q.y), floor(q.z));
-            let inside = |c: f64, n: usize| c >= -rc && c <= (n - 1) as f64 + rc;
-            if !(inside(cx, nx) && inside(cy, ny) && inside(cz, nz)) {
+            if !(near(cx, nx, rc) && near(cy, ny, rc) && near(cz, nz, rc)) {
                 return;
             }
             let cl = |c: f64, n: usize| (c.max(0.0) as usize).min(n - 1);
@@ -183,62 +193,40 @@ impl NeighbourGrid {
                 return;
             }
         }
-        let span = |c: f64, n: usize| -> Option<(usize, usize)> {
-            let lo = floor(c - r);
-            let hi = floor(c + r);
-            if hi < 0.0 || lo > (n - 1) as f64 || lo.is_nan() || hi.is_nan() {
-                return None;
-            }
-            Some((lo.max(0.0) as usize, (hi as usize).min(n - 1)))
+        // Squared gaps from p to the cells c − 2 … c + 2 along each axis (in cells), from the offset of p
+        // in its cell: computed once per query, compared per layer and row (no rounding or square root).
+        let sq = |c: f64, cf: f64| {
+            let t = c - cf;
+            [(t + 1.0) * (t + 1.0), t * t, 0.0, (1.0 - t) * (1.0 - t), (2.0 - t) * (2.0 - t)]
         };
-        let Some((mut z0, z1)) = span(q.z, nz) else { return };
-        let Some((y0, y1)) = span(q.y, ny) else { return };
-        // Own cell of p (clamped like the grid bins points).
-        let own = |c: f64, n: usize| (floor(c).max(0.0) as usize).min(n - 1);
-        let (oz, oy) = (own(q.z, nz), own(q.y, ny));
-        if after {
-            z0 = z0.max(oz);
-        }
-        let gap = |c: f64, k: usize| (k as f64 - c).max(c - (k + 1) as f64).max(0.0);
+        let (gx, gy, gz) = (sq(q.x, cx), sq(q.y, cy), sq(q.z, cz));
         let r2 = r * r;
-        // Cells are at least half the support (the grid only ever enlarges them), so a query reaches
-        // at most two cells beyond its own along each axis.
-        debug_assert!(r <= 2.0 + 1e-9, "query reach {r} cells");
-        // Along x, cell cx ± k (k = 1, 2) of a row is needed when its squared gap to p is within the
-        // row's remaining squared radius: squared gaps computed once per query, compared per row (no
-        // square root or rounding per row).
-        let cx = floor(q.x);
-        let fx = q.x - cx;
-        let (gl1, gl2, gr1, gr2) =
-            (fx * fx, (fx + 1.0) * (fx + 1.0), (1.0 - fx) * (1.0 - fx), (2.0 - fx) * (2.0 - fx));
-        let cx = cx as i64;
-        let mut gy2 = [0.0f64; 6];
-        for (g, y) in gy2.iter_mut().zip(y0..=y1) {
-            let d = gap(q.y, y);
-            *g = d * d;
-        }
-        for z in z0..=z1 {
-            let dz = gap(q.z, z);
-            let rz2 = r2 - dz * dz;
+        let (cx, cy, cz) = (cx as i64, cy as i64, cz as i64);
+        let (nx, ny, nz) = (nx as i64, ny as i64, nz as i64);
+        // Own cell of p, clamped like the grid bins points.
+        let (oy, oz) = (cy.clamp(0, ny - 1), cz.clamp(0, nz - 1));
+        let z_lo = (cz - 2).max(if after { oz } else { 0 });
+        for z in z_lo..=(cz + 2).min(nz - 1) {
+            let rz2 = r2 - gz[(z - cz + 2) as usize];
             if rz2 < 0.0 {
                 continue;
             }
-            let y_from = if after && z == oz { y0.max(oy) } else { y0 };
-            for y in y_from..=y1.min(y0 + 5) {
-                let rem = rz2 - gy2[y - y0];
+            let y_lo = (cy - 2).max(if after && z == oz { oy } else { 0 });
+            for y in y_lo..=(cy + 2).min(ny - 1) {
+                let rem = rz2 - gy[(y - cy + 2) as usize];
                 if rem < 0.0 {
                     continue;
                 }
-                let lo = cx - (gl1 <= rem) as i64 - (gl2 <= rem) as i64;
-                let hi = cx + (gr1 <= rem) as i64 + (gr2 <= rem) as i64;
-                if hi < 0 || lo > (nx - 1) as i64 {
+                // Along x, cell cx ± k (k = 1, 2) of the row is needed when its squared gap is within the
+                // row's remaining squared radius.
+                let lo = (cx - (gx[1] <= rem) as i64 - (gx[0] <= rem) as i64).max(0);
+                let hi = (cx + (gx[3] <= rem) as i64 + (gx[4] <= rem) as i64).min(nx - 1);
+                if lo > hi {
                     continue;
                 }
-                let x0 = lo.max(0) as usize;
-                let x1 = (hi as usize).min(nx - 1);
-                let row = (z * ny + y) * nx;
-                let start = self.cells.cell_range(row + x0).start;
-                let end = self.cells.cell_range(row + x1).end;
+                let row = ((z * ny + y) * nx) as usize;
+                let start = self.cells.cell_range(row + lo as usize).start;
+                let end = self.cells.cell_range(row + hi as usize).end;
                 if start < end {
                     f(start..end);
                 }

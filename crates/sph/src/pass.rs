@@ -478,7 +478,7 @@ fn fluid_pass_k<K: KernelFn, const EXTRA: bool>(
                    near_c: &mut [u32],
                    mut shift_c: Option<&mut [Vec3]>| {
         let mut st = PassStats::default();
-        let mut scratch = WallScratch { list: [0; BATCH], batch: Batch::new() };
+        let mut scratch = WallScratch { cand: Candidates::new(), batch: Batch::new() };
         for o in 0..acc_c.len() {
             let i = ci * CHUNK + o;
             let r = finish_particle::<K, EXTRA>(
@@ -566,35 +566,74 @@ fn pair_block<K: KernelFn, const EXTRA: bool>(
     offset: usize,
     out: &mut Acc,
 ) -> u64 {
-    // Neighbours are first collected without branching (a candidate is written and the count advanced
-    // only when it is within the support), then evaluated in a loop free of unpredictable branches.
-    const CAP: usize = 256;
-    let mut list = [0u32; CAP];
+    // Neighbours are first collected without branching (see [`Candidates`]), then evaluated in a loop
+    // free of unpredictable branches.
+    let mut cand = Candidates::new();
     let mut batch = Batch::new();
     let mut pairs = 0u64;
     for i in home {
         let xi = fl.pos[i];
         let mut st = PairState::new(fl, i, c);
-        let mut n = 0usize;
         fl.grid.for_each_run_after(xi, |run| {
-            let s = run.start.max(i + 1);
-            if s >= run.end {
-                return;
-            }
-            for (k, p) in fl.pos[s..run.end].iter().enumerate() {
-                if n == CAP {
-                    pairs += pair_list::<K, EXTRA>(kf, c, fl, &list[..n], &mut st, offset, out, &mut batch);
-                    n = 0;
-                }
-                let d = xi - *p;
-                list[n] = (s + k) as u32;
-                n += (d.length_squared() < c.r2max) as usize;
-            }
+            cand.collect(xi, c.r2max, fl.pos, run.start.max(i + 1)..run.end, |list| {
+                pairs += pair_list::<K, EXTRA>(kf, c, fl, list, &mut st, offset, out, &mut batch);
+            });
         });
-        pairs += pair_list::<K, EXTRA>(kf, c, fl, &list[..n], &mut st, offset, out, &mut batch);
+        pairs += pair_list::<K, EXTRA>(kf, c, fl, cand.take(), &mut st, offset, out, &mut batch);
         st.store(i - offset, out);
     }
     pairs
+}
+
+/// Branch-free collection of the neighbours of one point: the candidates of contiguous index ranges
+/// are tested against the squared cut-off, and every candidate's index is written to the next free slot
+/// of the list, which only advances when the candidate is within the cut-off (no unpredictable branch).
+struct Candidates {
+    list: [u32; BATCH],
+    n: usize,
+}
+
+impl Candidates {
+    fn new() -> Self {
+        Candidates { list: [0; BATCH], n: 0 }
+    }
+
+    /// Appends the indices `k` in `range` with `|x − pos[k]|² < r2max` \[m²\]; whenever the list is
+    /// full it is handed to `flush` and emptied.
+    #[inline(always)]
+    fn collect(
+        &mut self,
+        x: Vec3,
+        r2max: f64,
+        pos: &[Vec3],
+        range: std::ops::Range<usize>,
+        mut flush: impl FnMut(&[u32]),
+    ) {
+        let mut s = range.start;
+        while s < range.end {
+            if self.n == BATCH {
+                flush(&self.list);
+                self.n = 0;
+            }
+            // At most the free slots, so the loop below needs no capacity test.
+            let e = range.end.min(s + (BATCH - self.n));
+            let mut n = self.n;
+            for (k, p) in (s as u32..).zip(&pos[s..e]) {
+                // n < BATCH here; the mask only lets the compiler drop the bounds check.
+                self.list[n & (BATCH - 1)] = k;
+                n += ((x - *p).length_squared() < r2max) as usize;
+            }
+            self.n = n;
+            s = e;
+        }
+    }
+
+    /// The neighbours collected since the last flush; empties the list.
+    #[inline(always)]
+    fn take(&mut self) -> &[u32] {
+        let n = std::mem::replace(&mut self.n, 0);
+        &self.list[..n]
+    }
 }
 
 /// Running sums of the home particle of [`pair_block`].
@@ -733,12 +772,16 @@ struct Batch {
     cj: [f32; BATCH],
 }
 
+/// Neighbours per batch (a power of two, see [`Candidates::collect`]).
 const BATCH: usize = 256;
+const _: () = assert!(BATCH.is_power_of_two());
 
 /// Pressure, viscosity, continuity and δ-SPH terms for a list of neighbours, Wendland kernel, evaluated
 /// in single precision (positions and velocities enter as differences computed in double precision; sums
 /// are kept in double precision). Same terms as [`pair_terms`] without the extras.
-#[allow(clippy::too_many_arguments)]
+// Index loops up to n = min(chunk length, BATCH): the compiler then drops every bounds check of the batch
+// arrays (an iterator over the chunk measured 0.3–1.3 % more instructions per step).
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
 fn batch_pairs(
     c: &Consts,
     fl: &FluidSet,
@@ -750,29 +793,33 @@ fn batch_pairs(
     cw: f64,
     b: &mut Batch,
 ) {
+    // Arrays cut to equal lengths: one bounds test of a neighbour index then covers all of them.
+    let np = fl.pos.len();
+    let (pos, vel, rho, irho, pr) = (fl.pos, &fl.vel[..np], &fl.rho[..np], &fl.irho[..np], &fl.pr[..np]);
+    let (xi, vi, rhoi) = (st.xi, st.vi, st.si.0);
     for chunk in list.chunks(BATCH) {
-        let n = chunk.len();
+        let n = chunk.len().min(BATCH);
         // Gather.
-        for (t, &j) in chunk.iter().enumerate() {
-            let j = j as usize;
-            let d = st.xi - fl.pos[j];
-            let v = st.vi - fl.vel[j];
+        for t in 0..n {
+            let j = chunk[t] as usize;
+            let d = xi - pos[j];
+            let v = vi - vel[j];
             b.dx[t] = d.x as f32;
             b.dy[t] = d.y as f32;
             b.dz[t] = d.z as f32;
             b.vx[t] = v.x as f32;
             b.vy[t] = v.y as f32;
             b.vz[t] = v.z as f32;
-            b.drho[t] = (st.si.0 - fl.rho[j]) as f32;
-            b.irj[t] = fl.irho[j] as f32;
-            b.prj[t] = fl.pr[j] as f32;
+            b.drho[t] = (rhoi - rho[j]) as f32;
+            b.irj[t] = irho[j] as f32;
+            b.prj[t] = pr[j] as f32;
         }
         // Pair terms, vectorised.
         let (inv_h, cw, h) = (inv_h as f32, cw as f32, c.h as f32);
         let (eta2, av, m, nu, dc) = (c.eta2 as f32, c.av as f32, c.m as f32, c.nu as f32, c.dc as f32);
         let (gx, gy, gz) = (c.gk.x as f32, c.gk.y as f32, c.gk.z as f32);
         let (iri, pri) = (st.si.1 as f32, st.si.2 as f32);
-        for t in 0..n.min(BATCH) {
+        for t in 0..n {
             let (dx, dy, dz) = (b.dx[t], b.dy[t], b.dz[t]);
             let (vx, vy, vz) = (b.vx[t], b.vy[t], b.vz[t]);
             let r2 = dx * dx + dy * dy + dz * dz;
@@ -797,15 +844,17 @@ fn batch_pairs(
         // Scatter. The home sums live in locals: kept in `st`, they would be stored and reloaded for every
         // neighbour (the compiler cannot rule out that `out` aliases them).
         let (mut ax, mut ay, mut az, mut di) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        for (t, &j) in chunk.iter().enumerate() {
-            let o = j as usize - offset;
+        let no = out.acc.len();
+        let (acc_o, drho_o) = (&mut *out.acc, &mut out.drho[..no]);
+        for t in 0..n {
+            let o = chunk[t] as usize - offset;
             let a = Vec3::new(b.ax[t] as f64, b.ay[t] as f64, b.az[t] as f64);
             ax += a.x;
             ay += a.y;
             az += a.z;
-            out.acc[o] -= a;
+            acc_o[o] -= a;
             di += b.ci[t] as f64;
-            out.drho[o] += b.cj[t] as f64;
+            drho_o[o] += b.cj[t] as f64;
         }
         st.ai += Vec3::new(ax, ay, az);
         st.di += di;
@@ -814,7 +863,7 @@ fn batch_pairs(
 
 /// Buffers of the batched wall interactions.
 struct WallScratch {
-    list: [u32; BATCH],
+    cand: Candidates,
     batch: Batch,
 }
 
@@ -836,7 +885,6 @@ fn walls_batched(
     let mut d = 0.0;
     let mut near = 0u32;
     let mut count = 0u64;
-    let mut n = 0usize;
     let flush = |list: &[u32], b: &mut Batch, acc: &mut Vec3, d: &mut f64, near: &mut u32| {
         for (t, &j) in list.iter().enumerate() {
             let j = j as usize;
@@ -887,20 +935,13 @@ fn walls_batched(
             *d += b.ci[t] as f64;
         }
     };
-    let WallScratch { list, batch } = sc;
-    wl.grid.for_each_run(xi, |run| {
-        for (k, p) in wl.pos[run.clone()].iter().enumerate() {
-            if n == BATCH {
-                flush(&list[..n], batch, &mut acc, &mut d, &mut near);
-                count += n as u64;
-                n = 0;
-            }
-            list[n] = (run.start + k) as u32;
-            n += ((xi - *p).length_squared() < c.r2max) as usize;
-        }
-    });
-    flush(&list[..n], batch, &mut acc, &mut d, &mut near);
-    count += n as u64;
+    let WallScratch { cand, batch } = sc;
+    let mut flush_count = |list: &[u32]| {
+        flush(list, batch, &mut acc, &mut d, &mut near);
+        count += list.len() as u64;
+    };
+    wl.grid.for_each_run(xi, |run| cand.collect(xi, c.r2max, wl.pos, run, &mut flush_count));
+    flush_count(cand.take());
     (acc, d, near, count)
 }
 
