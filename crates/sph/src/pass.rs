@@ -617,11 +617,24 @@ impl Candidates {
             }
             // At most the free slots, so the loop below needs no capacity test.
             let e = range.end.min(s + (BATCH - self.n));
+            let list = &mut self.list;
             let mut n = self.n;
-            for (k, p) in (s as u32..).zip(&pos[s..e]) {
+            let mut test = |k: usize, p: &Vec3| {
                 // n < BATCH here; the mask only lets the compiler drop the bounds check.
-                self.list[n & (BATCH - 1)] = k;
+                list[n & (BATCH - 1)] = k as u32;
                 n += ((x - *p).length_squared() < r2max) as usize;
+            };
+            // Two candidates per iteration: the loop counter is a fifth of the work of one candidate.
+            let pairs = pos[s..e].chunks_exact(2);
+            let last = pairs.remainder();
+            let mut k = s;
+            for pq in pairs {
+                test(k, &pq[0]);
+                test(k + 1, &pq[1]);
+                k += 2;
+            }
+            if let Some(p) = last.first() {
+                test(k, p);
             }
             self.n = n;
             s = e;
