@@ -37,6 +37,10 @@ pub struct ComposedParams<NP, DP, TP, RP> {
     pub damping: DP,
     pub tangential: TP,
     pub rolling: RP,
+    /// √(k_t/S_n) when the tangential stiffness is a constant multiple of the damping stiffness for this
+    /// pair type (Hertz with Mindlin: √(8G*a/(2E*a)) = √(4G*/E*)), else `None`; passed to
+    /// [`DampingLaw::coefficients`].
+    pub stiffness_ratio_sqrt: Option<f64>,
 }
 
 /// Per-contact state of a [`Composed`] law: the states of its parts and nothing else (with Hertz,
@@ -61,11 +65,16 @@ where
     const USES_ROTATION: bool = R::USES_ROTATION;
 
     fn params(&self, pair_index: usize, props: &PairProps) -> Self::Params {
+        let normal = self.normal.params(pair_index, props);
+        let tangential = self.tangential.params(pair_index, props);
+        let ratio =
+            self.tangential.stiffness_ratio(&tangential, self.normal.damping_stiffness_per_radius(&normal));
         ComposedParams {
-            normal: self.normal.params(pair_index, props),
             damping: self.damping.params(pair_index, props, self.normal.damping_exponent()),
-            tangential: self.tangential.params(pair_index, props),
             rolling: self.rolling.params(pair_index, props),
+            stiffness_ratio_sqrt: ratio.filter(|r| *r >= 0.0 && r.is_finite()).map(f64::sqrt),
+            normal,
+            tangential,
         }
     }
 
@@ -84,7 +93,9 @@ where
         self.damping.in_contact(&p.damping, c, &mut s.damping);
         let n = c.normal;
         let vn = c.v_rel.dot(n);
-        let gamma_n = self.damping.normal_coefficient(&p.damping, &s.damping, &nf, c);
+        let k_t = self.tangential.stiffness(&p.tangential, &nf, c);
+        let (gamma_n, gamma_t) =
+            self.damping.coefficients(&p.damping, &s.damping, &nf, k_t, p.stiffness_ratio_sqrt, c);
         let mut f_n = nf.force - gamma_n * vn;
         if self.damping.tensile_clamp(&p.damping) {
             let floor = nf.force.min(0.0);
@@ -96,8 +107,6 @@ where
         let mut dissipated = if self.energy { -(f_n - nf.force) * vn * c.dt } else { 0.0 };
         let f_coulomb = nf.coulomb_force.unwrap_or(f_n.max(0.0));
         let v_t = c.v_rel - vn * n;
-        let k_t = self.tangential.stiffness(&p.tangential, &nf, c);
-        let gamma_t = self.damping.tangential_coefficient(&p.damping, &s.damping, k_t, c);
         let t = self.tangential.force(
             &p.tangential,
             &mut s.tangential,

@@ -34,6 +34,23 @@ pub trait DampingLaw: Clone + Debug + Send + Sync + 'static {
     /// Tangential dashpot coefficient γ_t ≥ 0 \[N s/m\] for tangential stiffness `k_t` \[N/m\].
     fn tangential_coefficient(&self, p: &Self::Params, s: &Self::State, k_t: f64, c: &ContactInput) -> f64;
 
+    /// Both dashpot coefficients (γ_n, γ_t) \[N s/m\], what the composed kernel calls. `ratio_sqrt` is
+    /// √(k_t/S_n) when k_t/S_n is a constant of the pair type (see [`super::TangentialLaw::stiffness_ratio`]),
+    /// so that a law whose coefficients go as √(m* S) can take γ_t from the square root of γ_n. The
+    /// default asks [`DampingLaw::normal_coefficient`] and [`DampingLaw::tangential_coefficient`].
+    #[inline(always)]
+    fn coefficients(
+        &self,
+        p: &Self::Params,
+        s: &Self::State,
+        nf: &NormalForce,
+        k_t: f64,
+        _ratio_sqrt: Option<f64>,
+        c: &ContactInput,
+    ) -> (f64, f64) {
+        (self.normal_coefficient(p, s, nf, c), self.tangential_coefficient(p, s, k_t, c))
+    }
+
     /// Whether damping may not make the normal force tensile (see [`crate::contact`] conventions).
     fn tensile_clamp(&self, p: &Self::Params) -> bool;
 }
@@ -128,6 +145,25 @@ impl DampingLaw for RestitutionDamping {
         c: &ContactInput,
     ) -> f64 {
         p.c_t * (c.m_eff * k_t).sqrt()
+    }
+
+    #[inline(always)]
+    fn coefficients(
+        &self,
+        p: &RestitutionDampingParams,
+        s: &(),
+        nf: &NormalForce,
+        k_t: f64,
+        ratio_sqrt: Option<f64>,
+        c: &ContactInput,
+    ) -> (f64, f64) {
+        let root = (c.m_eff * nf.damping_stiffness).sqrt();
+        let gamma_t = match ratio_sqrt {
+            // √(m* k_t) = √(m* S_n) √(k_t/S_n): one square root less per contact.
+            Some(r) => p.c_t * r * root,
+            None => self.tangential_coefficient(p, s, k_t, c),
+        };
+        (p.c_n * root, gamma_t)
     }
 
     #[inline(always)]

@@ -63,6 +63,8 @@
 //!    * `energy` — elastic energy stored \[J\] for the energy budget.
 //! 5. [`NormalLaw::damping_exponent`]: the exponent p of the power law F = kδᵖ whose exact
 //!    restitution calibration the damping should use (1 for Hooke, 1.5 for Hertz-like laws).
+//! 6. Optionally [`NormalLaw::damping_stiffness_per_radius`]: S_n/a if S_n is proportional to a in every
+//!    contact (Hertz: 2E*), so that with Mindlin the damping saves a square root per contact.
 //!
 //! Then use it as `Composed<MyLaw, RestitutionDamping, Mindlin, NoRolling>`. The engine, walls, meshes,
 //! history bookkeeping and checkpoints need no change.

@@ -44,6 +44,14 @@ pub trait NormalLaw: Clone + Debug + Send + Sync + 'static {
 
     /// Exponent p of the power law F = k δᵖ used to calibrate restitution damping (1 Hooke, 1.5 Hertz).
     fn damping_exponent(&self) -> f64;
+
+    /// S_n/a \[Pa\] when the damping stiffness is proportional to the contact radius in every contact of
+    /// the pair type (Hertz: S_n = 2E*a), else `None` (the default). With a tangential stiffness that is
+    /// proportional to a too (Mindlin), k_t/S_n is then a constant of the pair type
+    /// ([`super::TangentialLaw::stiffness_ratio`]), which saves a square root per contact.
+    fn damping_stiffness_per_radius(&self, _p: &Self::Params) -> Option<f64> {
+        None
+    }
 }
 
 /// How the Hooke spring stiffness is chosen.
@@ -156,5 +164,9 @@ impl NormalLaw for Hertz {
 
     fn damping_exponent(&self) -> f64 {
         1.5
+    }
+
+    fn damping_stiffness_per_radius(&self, p: &HertzParams) -> Option<f64> {
+        Some(2.0 * p.e_star)
     }
 }

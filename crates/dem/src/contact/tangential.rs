@@ -27,6 +27,13 @@ pub trait TangentialLaw: Clone + Debug + Send + Sync + 'static {
     /// Tangential stiffness k_t \[N/m\] (the damping law builds γ_t from it).
     fn stiffness(&self, p: &Self::Params, nf: &NormalForce, c: &ContactInput) -> f64;
 
+    /// k_t/S_n when it is a constant of the pair type, given S_n/a \[Pa\] of the normal law if that is one
+    /// ([`super::NormalLaw::damping_stiffness_per_radius`]); else `None` (the default). The damping law
+    /// may then derive γ_t from the square root it takes for γ_n ([`super::DampingLaw::coefficients`]).
+    fn stiffness_ratio(&self, _p: &Self::Params, _sn_per_radius: Option<f64>) -> Option<f64> {
+        None
+    }
+
     /// The tangential force for tangential relative velocity `v_t` \[m/s\], dashpot `gamma_t` \[N s/m\] and
     /// Coulomb normal force `f_coulomb` ≥ 0 \[N\]; updates the history in `state`. With `energy` false the
     /// returned energy and dissipation may be left zero.
@@ -118,10 +125,16 @@ fn spring_history(
     TangentialForce { force: f, dissipated, energy }
 }
 
-/// Implements [`TangentialLaw`] for a spring-with-history law from its stiffness k_t(params, normal force)
-/// and its history scale s(k_t/k_t,prev) (see [`spring_history`]): the laws differ only in these two.
+/// Implements [`TangentialLaw`] for a spring-with-history law from its stiffness k_t(params, normal force),
+/// its constant k_t/S_n if any (given S_n/a, see [`TangentialLaw::stiffness_ratio`]) and its history
+/// scale s(k_t/k_t,prev) (see [`spring_history`]): the laws differ only in these three.
 macro_rules! spring_law {
-    ($law:ty, |$l:ident, $p:ident, $nf:ident| $stiffness:expr, |$l2:ident, $ratio:ident| $scale:expr) => {
+    (
+        $law:ty,
+        |$l:ident, $p:ident, $nf:ident| $stiffness:expr,
+        |$l3:ident, $p3:ident, $sn_per_radius:ident| $stiffness_ratio:expr,
+        |$l2:ident, $ratio:ident| $scale:expr
+    ) => {
         impl TangentialLaw for $law {
             type Params = MindlinParams;
             type State = SpringHistory;
@@ -134,6 +147,11 @@ macro_rules! spring_law {
             fn stiffness(&self, $p: &MindlinParams, $nf: &NormalForce, _c: &ContactInput) -> f64 {
                 let $l = self;
                 $stiffness
+            }
+
+            fn stiffness_ratio(&self, $p3: &MindlinParams, $sn_per_radius: Option<f64>) -> Option<f64> {
+                let $l3 = self;
+                $stiffness_ratio
             }
 
             #[inline(always)]
@@ -193,7 +211,17 @@ pub struct SpringHistory {
     pub k_prev: f64,
 }
 
-spring_law!(Mindlin, |_law, p, nf| 8.0 * p.g_star * nf.contact_radius, |_law, _ratio| 1.0);
+spring_law!(
+    Mindlin,
+    |_law, p, nf| 8.0 * p.g_star * nf.contact_radius,
+    |_law, p, sn_per_radius| mindlin_stiffness_ratio(p, sn_per_radius),
+    |_law, _ratio| 1.0
+);
+
+/// k_t/S_n = 8G*a/(S_n/a · a) of a Mindlin spring when S_n/a is a constant (4G*/E* with Hertz).
+fn mindlin_stiffness_ratio(p: &MindlinParams, sn_per_radius: Option<f64>) -> Option<f64> {
+    sn_per_radius.filter(|&s| s > 0.0).map(|s| 8.0 * p.g_star / s)
+}
 
 /// Linear tangential spring k_t = `stiffness_ratio` × S_n (S_n = k_n for Hooke) with history and Coulomb
 /// cap. LIGGGHTS `hooke` uses ratio 1 (or 2/7 with `ktToKnUser`).
@@ -208,7 +236,12 @@ impl Default for LinearHistory {
     }
 }
 
-spring_law!(LinearHistory, |law, _p, nf| law.stiffness_ratio * nf.damping_stiffness, |_law, _ratio| 1.0);
+spring_law!(
+    LinearHistory,
+    |law, _p, nf| law.stiffness_ratio * nf.damping_stiffness,
+    |law, _p, _sn_per_radius| Some(law.stiffness_ratio),
+    |_law, _ratio| 1.0
+);
 
 /// No tangential force.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -223,6 +256,10 @@ impl TangentialLaw for Frictionless {
     #[inline(always)]
     fn stiffness(&self, _p: &(), _nf: &NormalForce, _c: &ContactInput) -> f64 {
         0.0
+    }
+
+    fn stiffness_ratio(&self, _p: &(), _sn_per_radius: Option<f64>) -> Option<f64> {
+        Some(0.0)
     }
 
     #[inline(always)]
@@ -291,6 +328,9 @@ pub struct MindlinVariant {
     pub history: MindlinHistory,
 }
 
-spring_law!(MindlinVariant, |_law, p, nf| 8.0 * p.g_star * nf.contact_radius, |law, ratio| law
-    .history
-    .scale(ratio));
+spring_law!(
+    MindlinVariant,
+    |_law, p, nf| 8.0 * p.g_star * nf.contact_radius,
+    |_law, p, sn_per_radius| mindlin_stiffness_ratio(p, sn_per_radius),
+    |law, ratio| law.history.scale(ratio)
+);
