@@ -260,6 +260,7 @@ pub(crate) fn wall_state(
             .zip(wet.par_chunks_mut(CHUNK))
             .enumerate()
             .for_each(|(ci, ((((rho_c, pr_c), ir_c), vv_c), wet_c))| {
+                let mut cand = Candidates::new();
                 for o in 0..rho_c.len() {
                     let b = ci * CHUNK + o;
                     let xb = wl.pos[b];
@@ -272,22 +273,23 @@ pub(crate) fn wall_state(
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
                     let mut is_wet = false;
                     for set in [fl, gh] {
-                        set.grid.for_each_run(xb, |run| {
-                            for j in run {
+                        // Neighbours collected without branching, then summed in the same order.
+                        let mut sum = |list: &[u32]| {
+                            for &j in list {
+                                let j = j as usize;
                                 let dx = xb - set.pos[j];
-                                let r2 = dx.length_squared();
-                                if r2 < c.r2max {
-                                    let w = kf.w(r2.sqrt());
-                                    sw += w;
-                                    spw += c.eos.pressure(set.rho[j]) * w;
-                                    srx += dx * (set.rho[j] * w);
-                                    svw += set.vel[j] * w;
-                                    let d = set.pos[j] - xs;
-                                    let dn = d.dot(normal);
-                                    is_wet |= dn.abs() < wet_n && d.length_squared() - dn * dn < wet_t2;
-                                }
+                                let w = kf.w(dx.length_squared().sqrt());
+                                sw += w;
+                                spw += c.eos.pressure(set.rho[j]) * w;
+                                srx += dx * (set.rho[j] * w);
+                                svw += set.vel[j] * w;
+                                let d = set.pos[j] - xs;
+                                let dn = d.dot(normal);
+                                is_wet |= dn.abs() < wet_n && d.length_squared() - dn * dn < wet_t2;
                             }
-                        });
+                        };
+                        set.grid.for_each_run(xb, |run| cand.collect(xb, c.r2max, set.pos, run, &mut sum));
+                        sum(cand.take());
                     }
                     let (p, vv) = if sw > 0.0 {
                         let f = &wl.frames[wl.part[b] as usize];
