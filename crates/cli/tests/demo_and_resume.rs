@@ -101,8 +101,8 @@ fn a_real_ctrl_c_interrupts_and_the_run_resumes_to_the_same_results() {
     let o = command(&whole, &[]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
-    // Interrupt once the third particle file (t = 0.04 s of 0.2 s) is written: the CSV tables are
-    // buffered until the run stops, the per-output VTU files are not.
+    // Interrupt once the third particle file (t = 0.04 s of 0.2 s) is written: VTU files are written whole
+    // at each output, CSV rows only reach the disk once a second.
     let mut child = command(&parts, &[]).stdout(std::process::Stdio::null()).spawn().unwrap();
     let start = Instant::now();
     loop {

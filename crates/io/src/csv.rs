@@ -5,15 +5,22 @@ use crate::fmt_f64;
 use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Rows reach the disk at least this often while a series is being written, so a long run's tables can
+/// be watched (and survive a hard kill) without a system call per row.
+pub const FLUSH_INTERVAL: Duration = Duration::from_secs(1);
 
 /// A numeric time series written row by row. Resumable: a checkpoint stores [`CsvSeries::bytes_written`]
 /// and [`CsvSeries::resume`] cuts the file back to that length before appending, so an interrupted and
-/// resumed run leaves the same file as an uninterrupted one.
+/// resumed run leaves the same file as an uninterrupted one. Buffered; a row is flushed with everything
+/// before it once [`FLUSH_INTERVAL`] has passed since the last flush.
 pub struct CsvSeries {
     path: PathBuf,
     out: BufWriter<File>,
     columns: usize,
     bytes: u64,
+    flushed_at: Instant,
 }
 
 fn with_path(e: io::Error, path: &Path) -> io::Error {
@@ -24,8 +31,13 @@ impl CsvSeries {
     /// Creates (or truncates) `path` and writes the header line.
     pub fn create(path: &Path, columns: &[&str]) -> io::Result<Self> {
         let file = File::create(path).map_err(|e| with_path(e, path))?;
-        let mut s =
-            CsvSeries { path: path.to_owned(), out: BufWriter::new(file), columns: columns.len(), bytes: 0 };
+        let mut s = CsvSeries {
+            path: path.to_owned(),
+            out: BufWriter::new(file),
+            columns: columns.len(),
+            bytes: 0,
+            flushed_at: Instant::now(),
+        };
         let header = columns.join(",") + "\n";
         s.write_raw(header.as_bytes())?;
         Ok(s)
@@ -49,6 +61,7 @@ impl CsvSeries {
             out: BufWriter::new(file),
             columns: columns.len(),
             bytes: byte_len,
+            flushed_at: Instant::now(),
         })
     }
 
@@ -79,10 +92,15 @@ impl CsvSeries {
             line.push_str(&fmt_f64(*v));
         }
         line.push('\n');
-        self.write_raw(line.as_bytes())
+        self.write_raw(line.as_bytes())?;
+        if self.flushed_at.elapsed() >= FLUSH_INTERVAL {
+            self.flush()?;
+        }
+        Ok(())
     }
 
     pub fn flush(&mut self) -> io::Result<()> {
+        self.flushed_at = Instant::now();
         self.out.flush().map_err(|e| with_path(e, &self.path))
     }
 
@@ -161,5 +179,19 @@ mod tests {
         assert_eq!(rows, vec![vec![0.0, 1.0], vec![0.1, 0.25]]);
         let mut c = CsvSeries::create(&p, &["a"]).unwrap();
         assert!(c.row(&[1.0, 2.0]).is_err(), "width mismatch is an error");
+    }
+
+    /// A row written after FLUSH_INTERVAL is on disk with the rows before it while the series is still
+    /// open (a running job's table can be watched).
+    #[test]
+    fn rows_reach_the_disk_while_the_series_is_open() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s.csv");
+        let mut a = CsvSeries::create(&p, &["t_s"]).unwrap();
+        a.row(&[0.0]).unwrap();
+        std::thread::sleep(FLUSH_INTERVAL + Duration::from_millis(50));
+        a.row(&[1.0]).unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "t_s\n0\n1\n");
+        drop(a);
     }
 }
