@@ -10,6 +10,13 @@ use spatter_sph::{Dim, Simulation, SphParams};
 
 const OPEN_TOP: [bool; 6] = [true, true, true, true, true, false];
 
+/// A simulation of `p` with an open-top tank of inner size `size` \[m\] (y = 0 in 2D) at the origin.
+fn in_open_tank(p: SphParams, size: Vec3) -> Simulation {
+    let mut sim = Simulation::new(p);
+    sim.add_tank("tank", Aabb::new(Vec3::ZERO, size), OPEN_TOP, None, None, WallOptions::default());
+    sim
+}
+
 /// A plate of one particle layer spanning the whole cross-section of a tank sweeps through the water at
 /// 1 m/s (prescribed by a tabulated motion): no particle ever gets from one side to the other, none is
 /// lost, and the wall guard did have work to do (the quick variant of `sph_thin_shell_leak`).
@@ -78,15 +85,7 @@ fn water_dropped_on_a_floor_reads_wet() {
     let dp = 0.01;
     let mut p = SphParams::water(Dim::Two, dp, 20.0);
     p.gravity = Vec3::new(0.0, 0.0, -9.81);
-    let mut sim = Simulation::new(p);
-    sim.add_tank(
-        "tank",
-        Aabb::new(Vec3::ZERO, Vec3::new(0.3, 0.0, 0.3)),
-        OPEN_TOP,
-        None,
-        None,
-        WallOptions::default(),
-    );
+    let mut sim = in_open_tank(p, Vec3::new(0.3, 0.0, 0.3));
     sim.fill_box(Aabb::new(Vec3::new(0.0, 0.0, 0.05), Vec3::new(0.3, 0.0, 0.1)), Vec3::ZERO, false);
     sim.initialize().unwrap();
     let b = &sim.boundary;
@@ -126,9 +125,7 @@ fn water_on_a_thin_shell_reads_wet() {
         let dp = 0.01;
         let mut p = SphParams::water(Dim::Three, dp, 20.0);
         p.gravity = Vec3::new(0.0, 0.0, -9.81);
-        let mut sim = Simulation::new(p);
-        let tank = Aabb::new(Vec3::ZERO, Vec3::new(0.2, 0.2, 0.3));
-        sim.add_tank("tank", tank, OPEN_TOP, None, None, WallOptions::default());
+        let mut sim = in_open_tank(p, Vec3::new(0.2, 0.2, 0.3));
         let mut plate = TriMesh::rectangle(0.24, 0.24, 0.0, 12, 12);
         plate.map_vertices(|v| Vec3::new(v.x - 0.02, v.y - 0.02, 0.05));
         let k = sim.add_mesh("plate", plate, Some(1), None, WallOptions::default()).unwrap();
@@ -199,15 +196,7 @@ fn results_do_not_depend_on_the_thread_count() {
 fn particles_leaving_the_domain_are_counted_not_fatal() {
     let mut p = SphParams::water(Dim::Two, 0.01, 30.0);
     p.gravity = Vec3::new(0.0, 0.0, -9.81);
-    let mut sim = Simulation::new(p);
-    sim.add_tank(
-        "tank",
-        Aabb::new(Vec3::ZERO, Vec3::new(0.3, 0.0, 0.2)),
-        OPEN_TOP,
-        None,
-        None,
-        WallOptions::default(),
-    );
+    let mut sim = in_open_tank(p, Vec3::new(0.3, 0.0, 0.2));
     let n0 = sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(0.1, 0.0, 0.1)), Vec3::new(0.0, 0.0, 2.5), false);
     sim.set_domain(Aabb::new(Vec3::new(-0.1, -1.0, -0.1), Vec3::new(0.4, 1.0, 0.25)));
     sim.initialize().unwrap();
