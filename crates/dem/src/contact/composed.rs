@@ -16,11 +16,37 @@ pub struct Composed<N, D, T, R> {
     /// Book stored and dissipated energy per contact (default true). Switching it off saves about 10 %
     /// of the contact time; [`ContactOutput::energy`] and [`ContactOutput::dissipated`] are then zero.
     pub energy: bool,
+    /// Which normal force caps Coulomb friction when the normal law leaves the choice open
+    /// ([`super::NormalForce::coulomb_force`] = `None`: Hooke, Hertz).
+    #[serde(default)]
+    pub coulomb_load: CoulombLoad,
+}
+
+/// The normal force F_c of the Coulomb cap |F_t| ≤ μ F_c for normal laws that leave the choice open.
+///
+/// The two conventions differ while the normal dashpot works: on loading the total force exceeds the
+/// elastic one, on unloading it is smaller and (with the tensile clamp) reaches zero before the overlap
+/// does, so with `Total` a contact always slides at its end and with `Elastic` it may leave sticking.
+/// LAMMPS `pair granular` and LIGGGHTS cap with the total force; Chung & Ooi's (2011) test 6 reference
+/// curve is reproduced only with the elastic force (docs/dem.md §4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CoulombLoad {
+    /// The total normal force after damping, clamped at zero (default).
+    #[default]
+    Total,
+    /// The elastic normal force F_ne of the normal law, clamped at zero.
+    Elastic,
 }
 
 impl<N, D, T, R> Composed<N, D, T, R> {
     pub fn new(normal: N, damping: D, tangential: T, rolling: R) -> Self {
-        Composed { normal, damping, tangential, rolling, energy: true }
+        Composed { normal, damping, tangential, rolling, energy: true, coulomb_load: CoulombLoad::Total }
+    }
+
+    /// The same law with Coulomb friction capped by `load`.
+    pub fn with_coulomb_load(self, load: CoulombLoad) -> Self {
+        Composed { coulomb_load: load, ..self }
     }
 }
 
@@ -105,7 +131,13 @@ where
         }
         // Work absorbed by the normal dashpot in this step: −F_d·v_n Δt ≥ 0.
         let mut dissipated = if self.energy { -(f_n - nf.force) * vn * c.dt } else { 0.0 };
-        let f_coulomb = nf.coulomb_force.unwrap_or(f_n.max(0.0));
+        let f_coulomb = nf.coulomb_force.unwrap_or(
+            match self.coulomb_load {
+                CoulombLoad::Total => f_n,
+                CoulombLoad::Elastic => nf.force,
+            }
+            .max(0.0),
+        );
         let v_t = c.v_rel - vn * n;
         let t = self.tangential.force(
             &p.tangential,

@@ -38,8 +38,9 @@
 //!   force ([`RestitutionDamping`]), so the realised coefficient of restitution equals the input e with the
 //!   clamp on or off (Chung & Ooi test 3). DESIGN.md §4 explains why this matters.
 //! * **Coulomb force.** The tangential force is capped at μ·F_c where F_c is the normal law's choice
-//!   ([`NormalForce::coulomb_force`]); for Hooke and Hertz it is the total (clamped) normal force including
-//!   damping, so that tangential and normal impulses keep the ratio μ when sliding (Chung & Ooi tests 4–6).
+//!   ([`NormalForce::coulomb_force`]); for Hooke and Hertz it is, by default, the total (clamped) normal
+//!   force including damping, so that tangential and normal impulses keep the ratio μ when sliding
+//!   (Chung & Ooi tests 4–6), or the elastic force with [`CoulombLoad::Elastic`].
 //!
 //! # Adding a normal law
 //!
@@ -58,7 +59,7 @@
 //!    * `damping_stiffness` — S_n \[N/m\] for the dashpot γ_n = c·√(m* S_n); return 0 for no damping
 //!      (e.g. in the JKR neck δ < 0, the LIGGGHTS convention), or 2E*a for the contact-radius variant;
 //!    * `contact_radius` — a \[m\], used by Mindlin (k_t = 8G*a) and for outputs;
-//!    * `coulomb_force` — `None` to cap friction with the total normal force, or `Some(F)` with the
+//!    * `coulomb_force` — `None` to leave the cap to [`Composed::coulomb_load`], or `Some(F)` with the
 //!      law's own choice (LAMMPS JKR uses |F_ne + 2F_c|);
 //!    * `energy` — elastic energy stored \[J\] for the energy budget.
 //! 5. [`NormalLaw::damping_exponent`]: the exponent p of the power law F = kδᵖ whose exact
@@ -77,7 +78,7 @@ pub mod restitution_fit;
 mod rolling;
 mod tangential;
 
-pub use composed::{Composed, ComposedParams, ComposedState};
+pub use composed::{Composed, ComposedParams, ComposedState, CoulombLoad};
 pub use damping::{
     DampingLaw, NoDamping, RestitutionCalibration, RestitutionDamping, RestitutionDampingParams,
 };

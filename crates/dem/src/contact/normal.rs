@@ -15,8 +15,9 @@ pub struct NormalForce {
     pub damping_stiffness: f64,
     /// Contact radius a \[m\] (Mindlin k_t = 8 G* a).
     pub contact_radius: f64,
-    /// The normal force that caps Coulomb friction, μ·F_c \[N\]: `None` = the total normal force after
-    /// damping (clamped at zero), `Some(F)` = the law's own choice (≥ 0).
+    /// The normal force that caps Coulomb friction, μ·F_c \[N\]: `None` = as the composed law's
+    /// [`super::CoulombLoad`] says (default: the total normal force after damping, clamped at zero),
+    /// `Some(F)` = the law's own choice (≥ 0).
     pub coulomb_force: Option<f64>,
     /// Elastic energy stored in the normal direction \[J\].
     pub energy: f64,

@@ -392,3 +392,40 @@ fn speed_dependent_damping_fixes_its_coefficient_at_first_touch_only() {
     law.in_contact(&p, &slow, &mut s_slow);
     assert!((s_slow.c_n - c_first).abs() > 1e-3 * c_first, "{} vs {c_first}", s_slow.c_n);
 }
+
+#[test]
+fn coulomb_load_chooses_the_total_or_the_elastic_normal_force() {
+    // A sliding Hertz contact unloading fast: the dashpot pulls the total normal force below the elastic
+    // one, here to the tensile clamp (zero). With `Total` the cap μ·max(F_n, 0) is then zero, with `Elastic`
+    // it is μ·F_ne = μ (4/3) E* √R* δ^{3/2} (Hertz closed form, exact up to round-off).
+    let mu = 0.4;
+    let props = PairProps::new(&glass(), &rigid(0.2), mu, 0.3);
+    let (r, m, dt, overlap): (f64, f64, f64, f64) = (0.005, 1e-3, 1e-8, 1e-6);
+    let f_ne = 4.0 / 3.0 * props.e_star * r.sqrt() * overlap.powf(1.5);
+    // Separating at 100 m/s: γ_n v_n ≫ F_ne, so the total normal force is clamped to zero.
+    let c = input(overlap, Vec3::new(5.0, 0.0, 100.0), r, m, dt);
+    for (load, cap) in [(CoulombLoad::Total, 0.0), (CoulombLoad::Elastic, mu * f_ne)] {
+        let law =
+            Composed::new(Hertz, RestitutionDamping::default(), Mindlin, NoRolling).with_coulomb_load(load);
+        let p = law.params(0, &props);
+        let mut s = Default::default();
+        let out = law.compute(&p, &c, &mut s).unwrap();
+        assert_eq!(out.normal_force, 0.0, "{load:?}: the clamp holds the total normal force at zero");
+        let ft = out.tangential_force(Vec3::Z);
+        assert!((ft.length() - cap).abs() <= 1e-12 * f_ne, "{load:?}: |F_t| {} vs μF_c {cap}", ft.length());
+        assert!(ft.x <= 0.0, "{load:?}: friction opposes the sliding direction");
+    }
+    // While loading, the dashpot adds to the elastic force: the elastic cap is the smaller one.
+    let c = input(overlap, Vec3::new(5.0, 0.0, -0.01), r, m, dt);
+    let caps: Vec<f64> = [CoulombLoad::Total, CoulombLoad::Elastic]
+        .iter()
+        .map(|&load| {
+            let law = Composed::new(Hertz, RestitutionDamping::default(), Mindlin, NoRolling)
+                .with_coulomb_load(load);
+            let mut s = Default::default();
+            let out = law.compute(&law.params(0, &props), &c, &mut s).unwrap();
+            out.tangential_force(Vec3::Z).length() / mu
+        })
+        .collect();
+    assert!((caps[1] - f_ne).abs() <= 1e-12 * f_ne && caps[0] > caps[1] * (1.0 + 1e-6), "caps {caps:?}");
+}

@@ -109,6 +109,10 @@ pub struct ContactConfig {
     /// Adhesive laws' Coulomb force: `plus_twice_pull_off` (default), `hertz` or `total`.
     #[serde(default)]
     pub adhesive_coulomb: AdhesiveCoulomb,
+    /// Hooke and Hertz: the normal force that caps friction, `total` (after damping, default) or
+    /// `elastic` ([`crate::contact::CoulombLoad`]).
+    #[serde(default)]
+    pub coulomb_load: crate::contact::CoulombLoad,
 }
 
 fn default_linear_ratio() -> f64 {
@@ -130,6 +134,7 @@ impl Default for ContactConfig {
             jkr_break: Default::default(),
             jkr_damping: Default::default(),
             adhesive_coulomb: Default::default(),
+            coulomb_load: Default::default(),
         }
     }
 }
@@ -623,6 +628,16 @@ impl Validate for SceneConfig {
                 c.fail(
                     "tangential",
                     "adhesive normal laws are combined with tangential = \"mindlin\" only".to_string(),
+                );
+            }
+            if matches!(k.normal, NormalKind::Jkr | NormalKind::Dmt | NormalKind::Sjkr)
+                && k.coulomb_load != crate::contact::CoulombLoad::Total
+            {
+                c.fail(
+                    "coulomb_load",
+                    "applies to normal = \"hertz\" or \"hooke\"; adhesive laws choose their Coulomb force \
+                     with adhesive_coulomb"
+                        .to_string(),
                 );
             }
         });

@@ -68,62 +68,68 @@ pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> 
         let ac = c.adhesive_coulomb;
         return match (c.normal, c.tangential) {
             (NormalKind::Hertz, TangentialKind::Linear) => {
-                run_with(tracked(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
+                run_with(configured(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
             }
             (NormalKind::Hertz, _) => {
-                run_with(tracked(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
+                run_with(configured(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
             }
             (NormalKind::Hooke, TangentialKind::Linear) => {
-                run_with(tracked(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
+                run_with(configured(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
             }
             (NormalKind::Hooke, _) => {
-                run_with(tracked(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
+                run_with(configured(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
             }
             (NormalKind::Jkr, _) => {
-                run_with(tracked(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
+                run_with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
             }
-            (NormalKind::Dmt, _) => {
-                run_with(tracked(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg), built, cfg, ctx)
-            }
-            (NormalKind::Sjkr, _) => {
-                run_with(tracked(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg), built, cfg, ctx)
-            }
+            (NormalKind::Dmt, _) => run_with(
+                configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg),
+                built,
+                cfg,
+                ctx,
+            ),
+            (NormalKind::Sjkr, _) => run_with(
+                configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg),
+                built,
+                cfg,
+                ctx,
+            ),
         };
     }
     // One monomorphised engine per combination.
     match (c.normal, c.tangential) {
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
-            run_with(tracked(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hertz, TangentialKind::Linear) => {
-            run_with(tracked(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Mindlin) => {
-            run_with(tracked(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
-            run_with(tracked(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
         }
         // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
         (NormalKind::Hertz, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(tracked(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Hooke, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(tracked(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Jkr, _) => {
-            run_with(tracked(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
+            run_with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
         (NormalKind::Dmt, _) => run_with(
-            tracked(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            configured(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
             cfg,
             ctx,
         ),
         (NormalKind::Sjkr, _) => run_with(
-            tracked(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            configured(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
             cfg,
             ctx,
@@ -185,8 +191,10 @@ impl Outputs {
 }
 
 /// Applies the scene's energy-tracking choice to a composed law.
-fn tracked<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> Composed<N, D, T, R> {
+/// The law with the scene's options that every combination shares (energy booking, Coulomb load).
+fn configured<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> Composed<N, D, T, R> {
     law.energy = cfg.engine.track_energy;
+    law.coulomb_load = cfg.contact.coulomb_load;
     law
 }
 

@@ -201,6 +201,35 @@ fn tangential_history_rule_is_selectable_from_the_scene() {
     assert_ne!(csv[0], csv[1], "the tangential rule changed nothing");
 }
 
+#[test]
+fn coulomb_load_is_selectable_from_the_scene_and_refused_for_adhesive_laws() {
+    use crate::contact::CoulombLoad;
+    for (key, load) in [("total", CoulombLoad::Total), ("elastic", CoulombLoad::Elastic)] {
+        let c: ContactConfig = toml::from_str(&format!("coulomb_load = \"{key}\"")).unwrap();
+        assert_eq!(c.coulomb_load, load, "{key}");
+    }
+    assert_eq!(ContactConfig::default().coulomb_load, CoulombLoad::Total);
+    assert!(toml::from_str::<ContactConfig>("coulomb_load = \"normal\"").is_err());
+    // The choice reaches the engine: damped contacts sliding on the floor and on each other feel another
+    // friction cap, so the energy history differs.
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+    let mut csv = Vec::new();
+    for load in [CoulombLoad::Total, CoulombLoad::Elastic] {
+        cfg.contact.coulomb_load = load;
+        let dir = RunDir::create(&tmp.path().join(format!("{load:?}"))).unwrap();
+        let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+        assert_eq!(s.finished, Finished::Completed);
+        csv.push(std::fs::read_to_string(dir.root().join("energy.csv")).unwrap());
+    }
+    assert_ne!(csv[0], csv[1], "the Coulomb load changed nothing");
+    // Adhesive laws choose their own Coulomb force: the key is an error there, naming it.
+    cfg.contact.normal = NormalKind::Jkr;
+    let errs = Checker::run(&cfg, None).unwrap_err();
+    let e = errs.iter().find(|e| e.key == "contact.coulomb_load").unwrap_or_else(|| panic!("{errs:?}"));
+    assert!(e.message.contains("adhesive_coulomb"), "{}", e.message);
+}
+
 /// The mixed scene of the insertion audit: a tube, a post standing through the fill and injection
 /// regions, a horizontal mesh plate across the fill region, a rotating paddle; a random log-normal fill,
 /// a lattice fill and a mass-rate injector.
