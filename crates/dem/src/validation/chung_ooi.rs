@@ -2,12 +2,12 @@
 //! level", Granular Matter 13:643–656 — tests 1 to 8 with the numbers of `VERIFICATION.md`.
 //!
 //! Hertz normal, Mindlin tangential with history, restitution damping with the tensile clamp (the
-//! engine's defaults). The "rigid plane" is a wall of E = ∞ with the sphere's Poisson ratio. Tests 2, 3, 4
+//! engine's defaults); test 6 also under the conventions of its reference curve. The "rigid plane" is a wall of E = ∞ with the sphere's Poisson ratio. Tests 2, 3, 4
 //! and 6 run against the analytic plane and against the same plane as a two-triangle STL with the impact
 //! on a face, on the shared edge and on the shared vertex.
 
 use super::impact::{pair_impact, wall_impact, Target};
-use crate::contact::HertzMindlin;
+use crate::contact::{Composed, CoulombLoad, Hertz, HertzMindlin, Mindlin, NoRolling, RestitutionDamping};
 use spatter_core::material::Material;
 use spatter_core::validation::Check;
 use spatter_core::Vec3;
@@ -55,6 +55,15 @@ fn copper() -> Material {
 /// The engine's default Hertz–Mindlin law.
 fn law() -> HertzMindlin {
     HertzMindlin::default()
+}
+
+/// Hertz–Mindlin under the conventions that reproduce Chung & Ooi's test 6 curve: damping without the
+/// tensile clamp (calibrated: e_out = e), friction capped by the elastic normal force. Without the clamp
+/// the dashpot's impulse over a contact is zero (γ_n depends on δ only), so in gross sliding the impulse
+/// ratio is still μ and the sliding branch stays exact.
+fn reference_convention_law() -> HertzMindlin {
+    let damping = RestitutionDamping { tensile_clamp: false, ..Default::default() };
+    Composed::new(Hertz, damping, Mindlin, NoRolling).with_coulomb_load(CoulombLoad::Elastic)
 }
 
 fn steps(quick: bool) -> f64 {
@@ -274,47 +283,52 @@ fn contact_velocity(v: Vec3, w: Vec3, r: f64, n: Vec3, t: Vec3) -> f64 {
 }
 
 /// Test 6: a spinning sphere dropped on a plane at 0.2 m/s, μ = 0.4, e = 0.5: β = −v′_st/v_st against
-/// x = 3.5μ(1+e)v_n/(Rω₀). Sliding (x < 1): β = x − 1 (absolute 0.01). Al alloy at the reference points
-/// x = 1.21, 2.09, 4.51, 11.9 (absolute 0.03 on β ∈ [−1, 1]).
+/// x = 3.5μ(1+e)v_n/(Rω₀). Sliding (x < 1): β = x − 1 (absolute 0.01), with the default law and with the
+/// reference convention. Al alloy at the reference points x = 1.21, 2.09, 4.51, 11.9 (absolute 0.03 on
+/// β ∈ [−1, 1]) with the reference convention ([`reference_convention_law`]).
 ///
-/// Known deviation (docs/dem.md §4): for x > 1 the contact sticks and β measures the elastic tangential
-/// rebound, which depends on the tangential law, its history rule and the damping. With the default law
-/// ours are 0.117, 0.123, −0.062, −0.045 against 0.096, 0.058, −0.139, −0.259; no tangential law or
-/// damping option of this crate reproduces 2.09 and 11.9 (`examples/tangential_laws_chung_ooi.rs`). The
-/// last three rows fail in the full report; the quick variant checks the sliding branch, which is exact.
+/// For x > 1 the contact sticks and β measures the elastic tangential rebound, which depends on the
+/// history rule and on the damping conventions. The reference curve (its shape over x = 0.18…24, not only
+/// the four points) is reproduced only when friction is capped by the elastic normal force and damping has
+/// no tensile clamp; with the default law (total force, clamp) β levels off at −0.05 beyond x ≈ 5 where the
+/// reference keeps falling to −0.34 at x = 24 (docs/dem.md §4). Under the reference convention x = 2.09
+/// fails (0.091 vs 0.058) in the full report. The quick variant checks the sliding branch with both laws
+/// and x = 4.51.
 pub fn test6(quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     let (mu, e, r, vn) = (0.4, 0.5, 0.1, 0.2);
     let xs_slide: &[f64] = if quick { &[0.5] } else { &[0.2, 0.5, 0.8] };
     let refs: &[(f64, f64)] = &[(1.21, 0.096), (2.09, 0.058), (4.51, -0.139), (11.9, -0.259)];
-    let refs: Vec<(f64, f64)> = if quick { Vec::new() } else { refs.to_vec() };
+    let refs: &[(f64, f64)] = if quick { &refs[2..3] } else { refs };
     for (name, m) in [("al_alloy", al_alloy()), ("nylon", nylon())] {
         for &tg in targets(quick) {
-            let case = format!("chung_ooi_6_{name}_{}", tg.label());
-            let run = |x: f64| {
-                let w0 = 3.5 * mu * (1.0 + e) * vn / (r * x);
-                // Spin about −(n × t̂) so that the contact point moves along +t̂ at speed R ω₀.
-                let o = wall_impact(&law(), &m, r, mu, e, vn, 0.0, -w0, tg, steps(quick));
-                let v_st =
-                    contact_velocity(Vec3::ZERO, -w0 * Vec3::Z.cross(o.tangent), r, Vec3::Z, o.tangent);
-                let v_st2 = contact_velocity(o.v, o.omega, r, Vec3::Z, o.tangent);
-                -v_st2 / v_st
-            };
-            for &x in xs_slide {
-                let beta = run(x);
-                out.push(Check::absolute(
-                    &case,
-                    format!("beta at x = {x} (sliding) [-]"),
-                    x - 1.0,
-                    beta,
-                    0.01,
-                    SRC,
-                ));
-            }
-            if name == "al_alloy" {
-                for &(x, b) in &refs {
+            for (convention, law) in [("", law()), ("_elastic_cap", reference_convention_law())] {
+                let case = format!("chung_ooi_6_{name}_{}{convention}", tg.label());
+                let run = |x: f64| {
+                    let w0 = 3.5 * mu * (1.0 + e) * vn / (r * x);
+                    // Spin about −(n × t̂) so that the contact point moves along +t̂ at speed R ω₀.
+                    let o = wall_impact(&law, &m, r, mu, e, vn, 0.0, -w0, tg, steps(quick));
+                    let v_st =
+                        contact_velocity(Vec3::ZERO, -w0 * Vec3::Z.cross(o.tangent), r, Vec3::Z, o.tangent);
+                    let v_st2 = contact_velocity(o.v, o.omega, r, Vec3::Z, o.tangent);
+                    -v_st2 / v_st
+                };
+                for &x in xs_slide {
                     let beta = run(x);
-                    out.push(Check::absolute(&case, format!("beta at x = {x} [-]"), b, beta, 0.03, SRC));
+                    out.push(Check::absolute(
+                        &case,
+                        format!("beta at x = {x} (sliding) [-]"),
+                        x - 1.0,
+                        beta,
+                        0.01,
+                        SRC,
+                    ));
+                }
+                if name == "al_alloy" && !convention.is_empty() {
+                    for &(x, b) in refs {
+                        let beta = run(x);
+                        out.push(Check::absolute(&case, format!("beta at x = {x} [-]"), b, beta, 0.03, SRC));
+                    }
                 }
             }
         }
