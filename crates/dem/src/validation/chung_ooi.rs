@@ -2,9 +2,10 @@
 //! level", Granular Matter 13:643–656 — tests 1 to 8 with the numbers of `VERIFICATION.md`.
 //!
 //! Hertz normal, Mindlin tangential with history, restitution damping with the tensile clamp (the
-//! engine's defaults); test 6 also under the conventions of its reference curve. The "rigid plane" is a wall of E = ∞ with the sphere's Poisson ratio. Tests 2, 3, 4
-//! and 6 run against the analytic plane and against the same plane as a two-triangle STL with the impact
-//! on a face, on the shared edge and on the shared vertex.
+//! engine's defaults); test 6 also under the conventions of its reference curve. The "rigid plane" is a
+//! wall of E = ∞ with the sphere's Poisson ratio. Tests 2, 3, 4 and 6 run against the analytic plane and
+//! against the same plane as a two-triangle STL with the impact on a face, on the shared edge and on the
+//! shared vertex.
 
 use super::impact::{pair_impact, wall_impact, Target};
 use crate::contact::{Composed, CoulombLoad, Hertz, HertzMindlin, Mindlin, NoRolling, RestitutionDamping};
