@@ -205,22 +205,25 @@ impl NeighbourGrid {
         let (nx, ny, nz) = (nx as i64, ny as i64, nz as i64);
         // Own cell of p, clamped like the grid bins points.
         let (oy, oz) = (cy.clamp(0, ny - 1), cz.clamp(0, nz - 1));
-        let z_lo = (cz - 2).max(if after { oz } else { 0 });
-        for z in z_lo..=(cz + 2).min(nz - 1) {
+        // The layers, and the rows of a layer, that hold cells within reach are contiguous around the
+        // own cell (the squared gaps grow away from it): their bounds come from the same comparisons as
+        // the x-extent of a row, without a branch per layer or row.
+        let span = |c: i64, g: &[f64; 5], rem: f64, n: i64| {
+            let lo = (c - (g[1] <= rem) as i64 - (g[0] <= rem) as i64).max(0);
+            let hi = (c + (g[3] <= rem) as i64 + (g[4] <= rem) as i64).min(n - 1);
+            (lo, hi)
+        };
+        let (z_lo, z_hi) = span(cz, &gz, r2, nz);
+        let z_lo = z_lo.max(if after { oz } else { 0 });
+        for z in z_lo..=z_hi {
             let rz2 = r2 - gz[(z - cz + 2) as usize];
-            if rz2 < 0.0 {
-                continue;
-            }
-            let y_lo = (cy - 2).max(if after && z == oz { oy } else { 0 });
-            for y in y_lo..=(cy + 2).min(ny - 1) {
+            let (y_lo, y_hi) = span(cy, &gy, rz2, ny);
+            let y_lo = y_lo.max(if after && z == oz { oy } else { 0 });
+            for y in y_lo..=y_hi {
                 let rem = rz2 - gy[(y - cy + 2) as usize];
-                if rem < 0.0 {
-                    continue;
-                }
                 // Along x, cell cx ± k (k = 1, 2) of the row is needed when its squared gap is within the
                 // row's remaining squared radius.
-                let lo = (cx - (gx[1] <= rem) as i64 - (gx[0] <= rem) as i64).max(0);
-                let hi = (cx + (gx[3] <= rem) as i64 + (gx[4] <= rem) as i64).min(nx - 1);
+                let (lo, hi) = span(cx, &gx, rem, nx);
                 if lo > hi {
                     continue;
                 }
