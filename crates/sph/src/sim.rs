@@ -744,12 +744,18 @@ impl Simulation {
         let p = &self.params;
         let h = p.h();
         let eos = p.eos();
-        let (mut vmax, mut rmax, mut rmin) = (0.0f64, 0.0f64, f64::INFINITY);
-        for (v, &r) in self.fluid.vel.iter().zip(&self.fluid.rho) {
-            vmax = vmax.max(v.length_squared());
-            rmax = rmax.max(r);
-            rmin = rmin.min(r);
-        }
+        // Maxima and minima do not depend on the order: reduced in parallel.
+        let (vmax, rmax, rmin) = self
+            .fluid
+            .vel
+            .par_iter()
+            .zip(self.fluid.rho.par_iter())
+            .with_min_len(4096)
+            .fold(
+                || (0.0f64, 0.0f64, f64::INFINITY),
+                |(vm, rx, rn), (v, &r)| (vm.max(v.length_squared()), rx.max(r), rn.min(r)),
+            )
+            .reduce(|| (0.0f64, 0.0f64, f64::INFINITY), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));
         let vmax = vmax.sqrt();
         let cmax = eos.sound_speed(rmax.max(p.rest_density));
         let vwall = self.boundary.max_speed();
@@ -927,35 +933,7 @@ impl Simulation {
         let lo_rho = self.params.density_window[0] * self.params.rest_density;
         let hi_rho = self.params.density_window[1] * self.params.rest_density;
         let w = &mut self.work;
-        let mut removed_domain = 0;
-        let mut removed_density = 0;
-        let mut first_removed = usize::MAX;
-        for i in 0..n {
-            let x = &mut self.fluid.pos[i];
-            let v = self.fluid.vel[i];
-            let rho = self.fluid.rho[i];
-            let what = if !spatter_core::math::is_finite(*x) {
-                Some("position")
-            } else if !spatter_core::math::is_finite(v) {
-                Some("velocity")
-            } else if !rho.is_finite() {
-                Some("density")
-            } else {
-                None
-            };
-            if let Some(what) = what {
-                return Err(SphError::BlowUp {
-                    step: self.steps + 1,
-                    time: self.time + self.dt,
-                    id: self.fluid.id[i],
-                    what,
-                    cause: format!(
-                        "the time step ({:.3e} s) is too large for the forces, or the sound speed ({} m/s) is below \
-                         10× the flow speed; lower `cfl` or raise the sound speed",
-                        self.dt, self.params.sound_speed
-                    ),
-                });
-            }
+        let wrap = |x: &mut Vec3| {
             for a in 0..3 {
                 if per[a] {
                     let len = d.max[a] - d.min[a];
@@ -966,14 +944,56 @@ impl Simulation {
                     }
                 }
             }
-            if !d.contains(*x) {
-                removed_domain += 1;
-                first_removed = first_removed.min(i);
-            } else if rho < lo_rho || rho > hi_rho {
-                removed_density += 1;
-                first_removed = first_removed.min(i);
-            }
+        };
+        // Scanned in parallel with the outcome of a scan in order: the first particle (lowest index) with
+        // a non-finite state stops the run, after the particles before it were wrapped.
+        let (pos, vel, rho) = (&mut self.fluid.pos, &self.fluid.vel, &self.fluid.rho);
+        let bad = {
+            let pos = &*pos;
+            (0..n).into_par_iter().with_min_len(4096).find_first(|&i| {
+                !(spatter_core::math::is_finite(pos[i])
+                    && spatter_core::math::is_finite(vel[i])
+                    && rho[i].is_finite())
+            })
+        };
+        if let Some(i) = bad {
+            pos[..i].par_iter_mut().with_min_len(4096).for_each(wrap);
+            let what = if !spatter_core::math::is_finite(pos[i]) {
+                "position"
+            } else if !spatter_core::math::is_finite(vel[i]) {
+                "velocity"
+            } else {
+                "density"
+            };
+            return Err(SphError::BlowUp {
+                step: self.steps + 1,
+                time: self.time + self.dt,
+                id: self.fluid.id[i],
+                what,
+                cause: format!(
+                    "the time step ({:.3e} s) is too large for the forces, or the sound speed ({} m/s) is below \
+                     10× the flow speed; lower `cfl` or raise the sound speed",
+                    self.dt, self.params.sound_speed
+                ),
+            });
         }
+        // Wrap, and count what leaves the domain or the density window (and the first such index).
+        let (removed_domain, removed_density, first_removed) = pos
+            .par_iter_mut()
+            .zip(rho.par_iter())
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(i, (x, &r))| {
+                wrap(x);
+                if !d.contains(*x) {
+                    (1, 0, i)
+                } else if r < lo_rho || r > hi_rho {
+                    (0, 1, i)
+                } else {
+                    (0, 0, usize::MAX)
+                }
+            })
+            .reduce(|| (0u64, 0u64, usize::MAX), |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2)));
         if removed_domain + removed_density > 0 {
             // Only now build the mask (no per-step buffer when nothing leaves).
             w.keep.clear();
