@@ -24,6 +24,7 @@ use crate::neighbours::NeighbourGrid;
 use crate::params::DragParams;
 use rayon::prelude::*;
 use spatter_core::Vec3;
+use std::sync::atomic::{AtomicU8, Ordering::Relaxed};
 
 /// Kernel evaluated in the hot loops (monomorphised per kernel kind).
 pub(crate) trait KernelFn: Copy + Send + Sync {
@@ -127,6 +128,37 @@ pub(crate) struct WallSet<'a> {
     pub vol: &'a [f64],
     pub part: &'a [u16],
     pub grid: &'a NeighbourGrid,
+    /// Per real fluid particle: 1 when some entry lies within the cut-off, as found by this step's
+    /// [`wall_state`] (symmetric test, same pairs); the fluid pass then skips the wall query of the others.
+    /// Empty when not known.
+    pub touched: &'a [AtomicU8],
+}
+
+/// Storage of [`WallSet::touched`]: one flag per real fluid particle, set from several threads.
+#[derive(Debug, Default)]
+pub(crate) struct WallFlags(Vec<AtomicU8>);
+
+impl Clone for WallFlags {
+    fn clone(&self) -> Self {
+        WallFlags(self.0.iter().map(|f| AtomicU8::new(f.load(Relaxed))).collect())
+    }
+}
+
+impl WallFlags {
+    /// `n` cleared flags.
+    pub fn reset(&mut self, n: usize) {
+        self.0.resize_with(n, || AtomicU8::new(0));
+        self.0.par_iter().with_min_len(4096).for_each(|f| f.store(0, Relaxed));
+    }
+
+    pub fn as_slice(&self) -> &[AtomicU8] {
+        &self.0
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.0.capacity()
+    }
 }
 
 /// Constants of one pass.
@@ -237,7 +269,8 @@ pub(crate) fn normals(kernel: &Kernel, c: &Consts, fl: FluidSet, gh: FluidSet, o
 /// Wall state of every entry of `wl`: Adami et al. (2012) pressure `p_b = (Σ p_f W + (g − a_b)·Σ ρ_f x_bf W)/Σ W`
 /// (clamped at 0 so walls never pull fluid; adhesion is modelled separately), density from the inverse
 /// Tait law, and the dummy velocity `2 v_wall − ṽ` (no slip) or `ṽ` (free slip), ṽ the Shepard average
-/// of the fluid velocity. Also sets `wet` when a fluid particle is within the wet distance.
+/// of the fluid velocity. Also sets `wet` when a fluid particle is within the wet distance, and
+/// `wl.touched` (when not empty) for every real fluid particle within the cut-off of an entry.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn wall_state(
     kernel: &Kernel,
@@ -272,11 +305,14 @@ pub(crate) fn wall_state(
                     let xs = xb + normal * c.wet_offset[part];
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
                     let mut is_wet = false;
-                    for set in [fl, gh] {
+                    for (set, touched) in [(fl, wl.touched), (gh, &[][..])] {
                         // Neighbours collected without branching, then summed in the same order.
                         let mut sum = |list: &[u32]| {
                             for &j in list {
                                 let j = j as usize;
+                                if !touched.is_empty() {
+                                    touched[j].store(1, Relaxed);
+                                }
                                 let dx = xb - set.pos[j];
                                 let w = kf.w(dx.length_squared().sqrt());
                                 sw += w;
@@ -1033,7 +1069,13 @@ fn finish_particle<K: KernelFn, const EXTRA: bool>(
     let mut near = 0u32;
     if !EXTRA {
         if let Some((inv_h, cw)) = kf.wendland() {
-            let (a, dd, nr, cnt) = walls_batched(c, wl, xi, vi, si, inv_h, cw, scratch);
+            // No wall entry within the cut-off (known from the wall pass): nothing to add.
+            let none = !wl.touched.is_empty() && wl.touched[i].load(Relaxed) == 0;
+            let (a, dd, nr, cnt) = if none {
+                (Vec3::ZERO, 0.0, 0, 0)
+            } else {
+                walls_batched(c, wl, xi, vi, si, inv_h, cw, scratch)
+            };
             acc += a;
             d += dd;
             near = nr;

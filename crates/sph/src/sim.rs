@@ -136,6 +136,8 @@ struct Work {
     w_grid: NeighbourGrid,
     w_tmp_u: Vec<u32>,
     w_tmp_b: Vec<bool>,
+    /// Fluid particles with a wall entry within the cut-off (set by the wall pass).
+    w_touched: pass::WallFlags,
     walls_built: bool,
     ready: bool,
     times: PhaseTimes,
@@ -661,6 +663,7 @@ impl Simulation {
             vol: &w.w_vol,
             part: &w.w_part,
             grid: &w.w_grid,
+            touched: w.w_touched.as_slice(),
         };
         (fl, gh, wl)
     }
@@ -671,6 +674,7 @@ impl Simulation {
         let kernel = self.kernel();
         let c = self.consts(self.dt);
         let w = &mut self.work;
+        w.w_touched.reset(self.fluid.len());
         let (mut rho, mut pr, mut irho) = (take(&mut w.w_rho), take(&mut w.w_pr), take(&mut w.w_irho));
         let (mut vvisc, mut wet) = (take(&mut w.w_vvisc), take(&mut w.w_wet));
         let (fl, gh, wl) = self.views();
@@ -1160,6 +1164,7 @@ impl Simulation {
             + b(&w.w_load)
             + b(&w.w_tmp_u)
             + b(&w.w_tmp_b)
+            + w.w_touched.bytes()
             + w.w_grid.bytes();
         (self.fluid.bytes() + fluid_scratch + images + walls) as f64 / self.fluid.len().max(1) as f64
     }
