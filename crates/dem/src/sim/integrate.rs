@@ -22,10 +22,21 @@ pub enum Integrator {
 impl<L: ContactLaw> Simulation<L> {
     /// Kicks velocities by `frac`·Δt·F/m (and ω by `frac`·Δt·τ/I); with `drift`, then moves positions by
     /// v·Δt. Frozen particles keep their velocity and move with it. Returns the largest speed after the
-    /// kick (for the neighbour-list displacement bound).
+    /// kick (for the neighbour-list displacement bound; 0 without `drift`, where no caller needs it).
     /// With `reset`, the force and torque arrays are then set to gravity (and the persistent external
     /// forces) for the next evaluation, in the same pass.
     pub(crate) fn kick_drift(&mut self, frac: f64, drift: bool, reset: bool) -> f64 {
+        match (drift, reset) {
+            (true, true) => self.kick_pass::<true, true>(frac),
+            (true, false) => self.kick_pass::<true, false>(frac),
+            (false, true) => self.kick_pass::<false, true>(frac),
+            (false, false) => self.kick_pass::<false, false>(frac),
+        }
+    }
+
+    /// [`Simulation::kick_drift`] with the options as constants, so that each pass keeps only its own work
+    /// in the loop (a kick without drift neither reads the positions nor tracks the largest speed).
+    fn kick_pass<const DRIFT: bool, const RESET: bool>(&mut self, frac: f64) -> f64 {
         let h = frac * self.dt;
         let dt = self.dt;
         let g = self.gravity;
@@ -41,13 +52,30 @@ impl<L: ContactLaw> Simulation<L> {
             .zip(p.pos.par_chunks_mut(CHUNK))
             .zip(p.force.par_chunks_mut(CHUNK).zip(p.torque.par_chunks_mut(CHUNK)))
             .enumerate()
-            .map(|(c, (((vs, ws), xs), (fs, ts)))| {
+            .map(move |(c, (((vs, ws), xs), (fs, ts)))| {
+                // Copies of the captured scalars and slices, so that the loops keep them in registers.
+                let (h, dt, g, has_ext, ext_f, ext_t) = (h, dt, g, has_ext, ext_f, ext_t);
                 let base = c * CHUNK;
                 let (inv_m, radius) = (&inv_m[base..base + vs.len()], &radius[base..base + vs.len()]);
                 let mut m: f64 = 0.0;
                 // Sum of all components: NaN or ∞ anywhere makes it non-finite (f64::max would hide a NaN;
-                // a finite sum that overflows only costs a search in `check_finite`).
+                // a finite sum that overflows only costs a search in `check_finite`). Without a drift the
+                // positions are unchanged since the last drift checked them.
                 let mut check = 0.0;
+                if !DRIFT {
+                    let particles = vs.iter_mut().zip(ws.iter_mut());
+                    let inputs = fs.iter_mut().zip(ts.iter_mut()).zip(inv_m.iter().zip(radius));
+                    for (k, ((v, w), ((f, t), (&im, &r)))) in particles.zip(inputs).enumerate() {
+                        let hm = h * im;
+                        *v += hm * *f;
+                        *w += (2.5 * hm / (r * r)) * *t;
+                        check += (*v + *w).element_sum();
+                        if RESET {
+                            reset_force(f, t, im, g, has_ext, ext_f, ext_t, base + k);
+                        }
+                    }
+                    return (m, check);
+                }
                 let particles = vs.iter_mut().zip(ws.iter_mut()).zip(xs.iter_mut());
                 let inputs = fs.iter_mut().zip(ts.iter_mut()).zip(inv_m.iter().zip(radius));
                 for (k, (((v, w), x), ((f, t), (&im, &r)))) in particles.zip(inputs).enumerate() {
@@ -56,27 +84,20 @@ impl<L: ContactLaw> Simulation<L> {
                     *v += hm * *f;
                     // 1/I = 2.5/(m r²).
                     *w += (2.5 * hm / (r * r)) * *t;
-                    if drift {
-                        *x += *v * dt;
-                    }
+                    *x += *v * dt;
                     let v2 = v.length_squared();
                     if v2 > m {
                         m = v2;
                     }
                     check += (*v + *w + *x).element_sum();
-                    if reset {
-                        *f = if im > 0.0 { g / im } else { Vec3::ZERO };
-                        *t = Vec3::ZERO;
-                        if has_ext {
-                            *f += ext_f[base + k];
-                            *t += ext_t[base + k];
-                        }
+                    if RESET {
+                        reset_force(f, t, im, g, has_ext, ext_f, ext_t, base + k);
                     }
                 }
                 (m, check)
             })
             .reduce(|| (0.0, 0.0), |a, b| (a.0.max(b.0), a.1 + b.1));
-        self.base_forces_ready = reset;
+        self.base_forces_ready = RESET;
         self.state_maybe_nonfinite |= !v2max.1.is_finite();
         v2max.0.sqrt()
     }
@@ -106,5 +127,27 @@ impl<L: ContactLaw> Simulation<L> {
                 cause: self.likely_cause(false),
             }),
         }
+    }
+}
+
+/// Sets the force and torque of particle `i` to gravity `g` (m g = g/(1/m); none for a frozen particle) plus
+/// its persistent external force and torque, if the run has any.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn reset_force(
+    f: &mut Vec3,
+    t: &mut Vec3,
+    im: f64,
+    g: Vec3,
+    has_ext: bool,
+    ext_f: &[Vec3],
+    ext_t: &[Vec3],
+    i: usize,
+) {
+    *f = if im > 0.0 { g / im } else { Vec3::ZERO };
+    *t = Vec3::ZERO;
+    if has_ext {
+        *f += ext_f[i];
+        *t += ext_t[i];
     }
 }
