@@ -85,6 +85,12 @@ impl<P: Clone> PairTable<P> {
         &self.items[a * self.n + b]
     }
 
+    /// The values of pairs (a, 0), (a, 1) … (a, n − 1).
+    #[inline(always)]
+    pub fn row(&self, a: usize) -> &[P] {
+        &self.items[a * self.n..][..self.n]
+    }
+
     /// Value at flat index `k = a·n + b`.
     #[inline(always)]
     pub fn at(&self, k: usize) -> &P {

@@ -94,8 +94,6 @@ fn spring_history(
     } else {
         x -= proj * n;
     }
-    // Energy stored at the end of the previous step (with the stiffness of then; the rotation keeps |ξ|).
-    let u_old = 0.5 * *k_prev * len2;
     x = x * scale + v_t * dt;
     let mut f = -k_t * x - gamma_t * v_t;
     let cap = mu * f_coulomb;
@@ -113,7 +111,8 @@ fn spring_history(
         }
     }
     *xi = x;
-    *k_prev = k_t;
+    // Energy stored at the end of the previous step (with the stiffness of then; the rotation keeps |ξ|).
+    let u_old = 0.5 * std::mem::replace(k_prev, k_t) * len2;
     if !track_energy {
         return TangentialForce { force: f, dissipated: 0.0, energy: 0.0 };
     }

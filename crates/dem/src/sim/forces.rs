@@ -320,29 +320,6 @@ impl<L: ContactLaw> Simulation<L> {
         // (short, independent iterations whose square roots and divisions overlap in the CPU), then the
         // contact law for each.
         const BUF: usize = 16;
-        /// A touching pair found in stage 1. The law sees it from particle a (the lower id of i and j, so
-        /// that each state stays in one frame): `sign` is +1 when a = i, −1 when a = j, and turns the
-        /// geometry seen from i into a's exactly (negation is exact).
-        #[derive(Clone, Copy, Default)]
-        struct Candidate {
-            /// Slot of the pair among i's neighbours.
-            slot: usize,
-            /// The partner of i.
-            j: usize,
-            sign: f64,
-            /// Flat pair-type index.
-            pair: usize,
-            /// Unit normal, from b to a.
-            normal: Vec3,
-            /// Overlap δ \[m\].
-            overlap: f64,
-            /// R* \[m\].
-            r_eff: f64,
-            /// m* \[kg\].
-            m_eff: f64,
-            /// Contact-point velocity of a minus b's \[m/s\].
-            v_rel: Vec3,
-        }
         let pair_work = |g: &Group,
                          pbase: usize,
                          (f, tq): (&mut [Vec3], &mut [Vec3]),
@@ -353,15 +330,51 @@ impl<L: ContactLaw> Simulation<L> {
             let (id, material, vel, omega, radius, inv_mass) =
                 (&id[..np], &material[..np], &vel[..np], &omega[..np], &radius[..np], &inv_mass[..np]);
             let tq = &mut tq[..f.len()];
-            let mut acc = Acc::default();
-            let mut buf = [Candidate::default(); BUF];
-            for i in g.work_begin as usize..g.work_end as usize {
-                let (k0, k1) = (l_start[i] as usize, l_start[i + 1] as usize);
+            let mut stage2 = PairStage {
+                law,
+                id,
+                omega,
+                inv_mass,
+                dt,
+                f,
+                tq,
+                pbase,
+                acc: Acc::default(),
+                fi: Vec3::ZERO,
+                ti: Vec3::ZERO,
+            };
+            // A group has particles, so the pair table has at least one entry to fill the buffer with.
+            let mut buf = [Candidate {
+                slot: 0,
+                j: 0,
+                sign: 0.0,
+                rj: 0.0,
+                params: params.at(0),
+                normal: Vec3::ZERO,
+                overlap: 0.0,
+                r_eff: 0.0,
+                m_eff: 0.0,
+                v_rel: Vec3::ZERO,
+            }; BUF];
+            // i's neighbours and contact states are consecutive: carve them off the front of the rest.
+            let (wb, we) = (g.work_begin as usize, g.work_end as usize);
+            let starts = &l_start[wb..we + 1];
+            let first = starts[0] as usize;
+            let mut nbr_rest = &l_nbr[first..];
+            let mut slot_rest = &mut states[first - sbase..];
+            for (i, (&k0, &k1)) in (wb..we).zip(starts.iter().zip(&starts[1..])) {
+                let len = (k1 - k0) as usize;
+                let (nbrs, nr) = nbr_rest.split_at(len);
+                nbr_rest = nr;
+                let (slots, sr) = std::mem::take(&mut slot_rest).split_at_mut(len);
+                slot_rest = sr;
                 let (xi, ri, ii) = (pos[i], radius[i], inv_mass[i]);
-                // Force and torque on i are summed in registers and stored once.
-                let (mut fi, mut ti) = (Vec3::ZERO, Vec3::ZERO);
-                let nbrs = &l_nbr[k0..k1];
-                let slots = &mut states[k0 - sbase..][..nbrs.len()];
+                // Loop invariants of i's geometry (the products are the same as inside the loop).
+                let (vi, wri) = (vel[i], ri * omega[i]);
+                let row = params.row(material[i] as usize);
+                // Force and torque on i are summed apart (in stage 2) and stored once.
+                stage2.fi = Vec3::ZERO;
+                stage2.ti = Vec3::ZERO;
                 let mut c0 = 0;
                 while c0 < nbrs.len() {
                     let c1 = nbrs.len().min(c0 + BUF);
@@ -392,70 +405,24 @@ impl<L: ContactLaw> Simulation<L> {
                             slot,
                             j,
                             sign,
-                            pair: params.flat(material[i] as usize, material[j] as usize),
+                            rj,
+                            params: &row[material[j] as usize],
                             normal: sign * n,
                             overlap: rs - dist,
                             r_eff: ri * rj * inv * q,
                             m_eff: rs * q,
-                            v_rel: sign * (vel[i] - vel[j] - (ri * omega[i] + rj * omega[j]).cross(n)),
+                            v_rel: sign * (vi - vel[j] - (wri + rj * omega[j]).cross(n)),
                         };
                         nbuf += 1;
                     }
-                    for cand in &buf[..nbuf] {
-                        let (j, s) = (cand.j, cand.sign);
-                        let rj = radius[j];
-                        let (i_eff, w_rel) = if L::USES_ROTATION {
-                            let inv_i = 2.5 * (ii / (ri * ri) + inv_mass[j] / (rj * rj));
-                            (1.0 / inv_i, s * (omega[i] - omega[j]))
-                        } else {
-                            (0.0, Vec3::ZERO)
-                        };
-                        let c = ContactInput {
-                            normal: cand.normal,
-                            overlap: cand.overlap,
-                            r_eff: cand.r_eff,
-                            m_eff: cand.m_eff,
-                            i_eff,
-                            v_rel: cand.v_rel,
-                            w_rel,
-                            dt,
-                        };
-                        let state = &mut slots[cand.slot];
-                        match law.compute(params.at(cand.pair), &c, state) {
-                            None => *state = default,
-                            Some(o) => {
-                                // The force acts on a, which is i for s = 1 and j for s = −1.
-                                let fv = s * o.force;
-                                let cr = c.normal.cross(o.force);
-                                fi += fv;
-                                f[j - pbase] -= fv;
-                                if L::USES_ROTATION {
-                                    let rt = s * o.rolling_torque;
-                                    ti += rt - ri * cr;
-                                    tq[j - pbase] -= rt + rj * cr;
-                                } else {
-                                    // No rolling torque (see `ContactLaw::USES_ROTATION`).
-                                    ti -= ri * cr;
-                                    tq[j - pbase] -= rj * cr;
-                                }
-                                acc.dissipated += o.dissipated;
-                                acc.elastic += o.energy;
-                                acc.pair_contacts += 1;
-                                // Radii are positive: a compare is enough (no NaN handling).
-                                let rmin = if ri < rj { ri } else { rj };
-                                if c.overlap > acc.max_ratio * rmin {
-                                    let (a, b) = if s > 0.0 { (i, j) } else { (j, i) };
-                                    acc.note_overlap(c.overlap / rmin, id[a], id[b]);
-                                }
-                            }
-                        }
-                    }
+                    stage2.contacts(&buf[..nbuf], slots, i, ri, ii);
                     c0 = c1;
                 }
-                f[i - pbase] += fi;
-                tq[i - pbase] += ti;
+                let (fi, ti) = (stage2.fi, stage2.ti);
+                stage2.f[i - pbase] += fi;
+                stage2.tq[i - pbase] += ti;
             }
-            acc
+            stage2.acc
         };
         let mut acc = acc_w;
         for phase in 0..2 {
@@ -597,6 +564,130 @@ impl<L: ContactLaw> Simulation<L> {
              moduli and wall motion)"
                 .into()
         }
+    }
+}
+
+/// A touching pair found in stage 1 of the pair loop. The law sees it from particle a (the lower id of i
+/// and j, so that each state stays in one frame): `sign` is +1 when a = i, −1 when a = j, and turns the
+/// geometry seen from i into a's exactly (negation is exact).
+struct Candidate<'p, P> {
+    /// Slot of the pair among i's neighbours.
+    slot: usize,
+    /// The partner of i.
+    j: usize,
+    sign: f64,
+    /// Radius of j \[m\].
+    rj: f64,
+    /// Parameters of the pair type (looked up, and bounds-checked, in stage 1).
+    params: &'p P,
+    /// Unit normal, from b to a.
+    normal: Vec3,
+    /// Overlap δ \[m\].
+    overlap: f64,
+    /// R* \[m\].
+    r_eff: f64,
+    /// m* \[kg\].
+    m_eff: f64,
+    /// Contact-point velocity of a minus b's \[m/s\].
+    v_rel: Vec3,
+}
+
+impl<P> Clone for Candidate<'_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<P> Copy for Candidate<'_, P> {}
+
+/// Stage 2 of the pair loop for one group: what it reads, and the sums it adds into.
+struct PairStage<'a, L: ContactLaw> {
+    law: &'a L,
+    id: &'a [u32],
+    omega: &'a [Vec3],
+    inv_mass: &'a [f64],
+    /// Time step \[s\].
+    dt: f64,
+    /// Forces \[N\] and torques \[N m\] of the group's particles, indexed from particle `pbase`.
+    f: &'a mut [Vec3],
+    tq: &'a mut [Vec3],
+    pbase: usize,
+    acc: Acc,
+    /// Running sums of the pair forces \[N\] and torques \[N m\] on the current particle i.
+    fi: Vec3,
+    ti: Vec3,
+}
+
+impl<L: ContactLaw> PairStage<'_, L> {
+    /// The contact law for each touching pair `cands` of particle `i` (radius `ri` \[m\], inverse mass
+    /// `ii` \[1/kg\]), whose states are `slots` (indexed by `Candidate::slot`): adds the forces and torques
+    /// on the partners, the sums on i and the bookkeeping. Kept out of line (one call per block of up to 16
+    /// neighbours): inlined into the neighbour loop, its values shared the registers with stage 1's
+    /// geometry and were spilled to the stack in every contact.
+    #[inline(never)]
+    fn contacts(
+        &mut self,
+        cands: &[Candidate<'_, L::Params>],
+        slots: &mut [L::State],
+        i: usize,
+        ri: f64,
+        ii: f64,
+    ) {
+        let (law, id, omega, inv_mass, dt, pbase) =
+            (self.law, self.id, self.omega, self.inv_mass, self.dt, self.pbase);
+        let default = L::State::default();
+        let f = &mut *self.f;
+        let tq = &mut self.tq[..f.len()];
+        let (mut acc, mut fi, mut ti) = (self.acc, self.fi, self.ti);
+        for cand in cands {
+            let (j, s, rj) = (cand.j, cand.sign, cand.rj);
+            let (i_eff, w_rel) = if L::USES_ROTATION {
+                let inv_i = 2.5 * (ii / (ri * ri) + inv_mass[j] / (rj * rj));
+                (1.0 / inv_i, s * (omega[i] - omega[j]))
+            } else {
+                (0.0, Vec3::ZERO)
+            };
+            let c = ContactInput {
+                normal: cand.normal,
+                overlap: cand.overlap,
+                r_eff: cand.r_eff,
+                m_eff: cand.m_eff,
+                i_eff,
+                v_rel: cand.v_rel,
+                w_rel,
+                dt,
+            };
+            let state = &mut slots[cand.slot];
+            match law.compute(cand.params, &c, state) {
+                None => *state = default,
+                Some(o) => {
+                    // The force acts on a, which is i for s = 1 and j for s = −1.
+                    let fv = s * o.force;
+                    let cr = c.normal.cross(o.force);
+                    fi += fv;
+                    f[j - pbase] -= fv;
+                    if L::USES_ROTATION {
+                        let rt = s * o.rolling_torque;
+                        ti += rt - ri * cr;
+                        tq[j - pbase] -= rt + rj * cr;
+                    } else {
+                        // No rolling torque (see `ContactLaw::USES_ROTATION`).
+                        ti -= ri * cr;
+                        tq[j - pbase] -= rj * cr;
+                    }
+                    acc.dissipated += o.dissipated;
+                    acc.elastic += o.energy;
+                    acc.pair_contacts += 1;
+                    // Radii are positive: a compare is enough (no NaN handling).
+                    let rmin = if ri < rj { ri } else { rj };
+                    if c.overlap > acc.max_ratio * rmin {
+                        let (a, b) = if s > 0.0 { (i, j) } else { (j, i) };
+                        acc.note_overlap(c.overlap / rmin, id[a], id[b]);
+                    }
+                }
+            }
+        }
+        (self.acc, self.fi, self.ti) = (acc, fi, ti);
     }
 }
 
