@@ -949,19 +949,39 @@ impl Simulation {
                 }
             }
         };
-        // Scanned in parallel with the outcome of a scan in order: the first particle (lowest index) with
-        // a non-finite state stops the run, after the particles before it were wrapped.
+        // One parallel read pass with the outcome of a scan in order: the first particle (lowest index)
+        // with a non-finite state stops the run, after the particles before it were wrapped; otherwise the
+        // counts of what leaves the domain (judged at the wrapped position) or the density window, and
+        // the first such index. Positions are written only when an axis is periodic.
         let (pos, vel, rho) = (&mut self.fluid.pos, &self.fluid.vel, &self.fluid.rho);
-        let bad = {
-            let pos = &*pos;
-            (0..n).into_par_iter().with_min_len(4096).find_first(|&i| {
-                !(spatter_core::math::is_finite(pos[i])
-                    && spatter_core::math::is_finite(vel[i])
-                    && rho[i].is_finite())
+        let none = (usize::MAX, 0u64, 0u64, usize::MAX);
+        let (bad, removed_domain, removed_density, first_removed) = pos
+            .par_iter()
+            .zip(vel.par_iter().zip(rho.par_iter()))
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(i, (x, (v, &r)))| {
+                if !(spatter_core::math::is_finite(*x) && spatter_core::math::is_finite(*v) && r.is_finite())
+                {
+                    return (i, 0, 0, usize::MAX);
+                }
+                let mut y = *x;
+                wrap(&mut y);
+                if !d.contains(y) {
+                    (usize::MAX, 1, 0, i)
+                } else if r < lo_rho || r > hi_rho {
+                    (usize::MAX, 0, 1, i)
+                } else {
+                    none
+                }
             })
-        };
-        if let Some(i) = bad {
-            pos[..i].par_iter_mut().with_min_len(4096).for_each(wrap);
+            .reduce(|| none, |a, b| (a.0.min(b.0), a.1 + b.1, a.2 + b.2, a.3.min(b.3)));
+        let periodic = per.iter().any(|&p| p);
+        if bad < n {
+            let i = bad;
+            if periodic {
+                pos[..i].par_iter_mut().with_min_len(4096).for_each(wrap);
+            }
             let what = if !spatter_core::math::is_finite(pos[i]) {
                 "position"
             } else if !spatter_core::math::is_finite(vel[i]) {
@@ -981,23 +1001,9 @@ impl Simulation {
                 ),
             });
         }
-        // Wrap, and count what leaves the domain or the density window (and the first such index).
-        let (removed_domain, removed_density, first_removed) = pos
-            .par_iter_mut()
-            .zip(rho.par_iter())
-            .enumerate()
-            .with_min_len(4096)
-            .map(|(i, (x, &r))| {
-                wrap(x);
-                if !d.contains(*x) {
-                    (1, 0, i)
-                } else if r < lo_rho || r > hi_rho {
-                    (0, 1, i)
-                } else {
-                    (0, 0, usize::MAX)
-                }
-            })
-            .reduce(|| (0u64, 0u64, usize::MAX), |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2)));
+        if periodic {
+            pos.par_iter_mut().with_min_len(4096).for_each(wrap);
+        }
         if removed_domain + removed_density > 0 {
             // Only now build the mask (no per-step buffer when nothing leaves).
             w.keep.clear();
