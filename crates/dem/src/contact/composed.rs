@@ -115,6 +115,33 @@ where
 
     #[inline(always)]
     fn compute(&self, p: &Self::Params, c: &ContactInput, s: &mut Self::State) -> Option<ContactOutput> {
+        // One copy of the kernel per combination of the run-time options: they are tested once per contact
+        // instead of at every use (the same arithmetic either way).
+        match (self.energy, self.coulomb_load) {
+            (true, CoulombLoad::Total) => self.kernel::<true, false>(p, c, s),
+            (true, CoulombLoad::Elastic) => self.kernel::<true, true>(p, c, s),
+            (false, CoulombLoad::Total) => self.kernel::<false, false>(p, c, s),
+            (false, CoulombLoad::Elastic) => self.kernel::<false, true>(p, c, s),
+        }
+    }
+}
+
+impl<N, D, T, R> Composed<N, D, T, R>
+where
+    N: NormalLaw,
+    D: DampingLaw,
+    T: TangentialLaw,
+    R: RollingLaw,
+{
+    /// [`ContactLaw::compute`] with the options as constants: `ENERGY` = [`Composed::energy`],
+    /// `ELASTIC_LOAD` = ([`Composed::coulomb_load`] is [`CoulombLoad::Elastic`]).
+    #[inline(always)]
+    fn kernel<const ENERGY: bool, const ELASTIC_LOAD: bool>(
+        &self,
+        p: &<Self as ContactLaw>::Params,
+        c: &ContactInput,
+        s: &mut <Self as ContactLaw>::State,
+    ) -> Option<ContactOutput> {
         let nf = self.normal.evaluate(&p.normal, c, &mut s.normal)?;
         self.damping.in_contact(&p.damping, c, &mut s.damping);
         let n = c.normal;
@@ -130,27 +157,13 @@ where
             }
         }
         // Work absorbed by the normal dashpot in this step: −F_d·v_n Δt ≥ 0.
-        let mut dissipated = if self.energy { -(f_n - nf.force) * vn * c.dt } else { 0.0 };
-        let f_coulomb = nf.coulomb_force.unwrap_or(
-            match self.coulomb_load {
-                CoulombLoad::Total => f_n,
-                CoulombLoad::Elastic => nf.force,
-            }
-            .max(0.0),
-        );
+        let mut dissipated = if ENERGY { -(f_n - nf.force) * vn * c.dt } else { 0.0 };
+        let f_coulomb = nf.coulomb_force.unwrap_or(if ELASTIC_LOAD { nf.force } else { f_n }.max(0.0));
         let v_t = c.v_rel - vn * n;
-        let t = self.tangential.force(
-            &p.tangential,
-            &mut s.tangential,
-            k_t,
-            gamma_t,
-            f_coulomb,
-            v_t,
-            c,
-            self.energy,
-        );
+        let t =
+            self.tangential.force(&p.tangential, &mut s.tangential, k_t, gamma_t, f_coulomb, v_t, c, ENERGY);
         let (rolling_torque, roll_diss) = self.rolling.torque(&p.rolling, &mut s.rolling, f_coulomb, c);
-        if self.energy {
+        if ENERGY {
             dissipated += t.dissipated + roll_diss * c.dt;
         }
         Some(ContactOutput {
@@ -158,7 +171,7 @@ where
             normal_force: f_n,
             rolling_torque,
             dissipated,
-            energy: if self.energy { nf.energy + t.energy } else { 0.0 },
+            energy: if ENERGY { nf.energy + t.energy } else { 0.0 },
         })
     }
 }
