@@ -190,15 +190,22 @@ fn tangential_history_rule_is_selectable_from_the_scene() {
     // energy history than the default (the particles stick and slide on the floor and on each other).
     let tmp = tempfile::tempdir().unwrap();
     let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
-    let mut csv = Vec::new();
-    for kind in [TangentialKind::Mindlin, TangentialKind::MindlinRescaleForce] {
-        cfg.contact.tangential = kind;
-        let dir = RunDir::create(&tmp.path().join(format!("{kind:?}"))).unwrap();
-        let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
-        assert_eq!(s.finished, Finished::Completed);
-        csv.push(std::fs::read_to_string(dir.root().join("energy.csv")).unwrap());
-    }
+    let csv: Vec<String> = [TangentialKind::Mindlin, TangentialKind::MindlinRescaleForce]
+        .into_iter()
+        .map(|kind| {
+            cfg.contact.tangential = kind;
+            energy_history(&cfg, &tmp.path().join(format!("{kind:?}")))
+        })
+        .collect();
     assert_ne!(csv[0], csv[1], "the tangential rule changed nothing");
+}
+
+/// Runs `cfg` to completion into `dir` and returns its `energy.csv`.
+fn energy_history(cfg: &SceneConfig, dir: &Path) -> String {
+    let dir = RunDir::create(dir).unwrap();
+    let s = run(cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    std::fs::read_to_string(dir.root().join("energy.csv")).unwrap()
 }
 
 #[test]
@@ -214,14 +221,13 @@ fn coulomb_load_is_selectable_from_the_scene_and_refused_for_adhesive_laws() {
     // friction cap, so the energy history differs.
     let tmp = tempfile::tempdir().unwrap();
     let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
-    let mut csv = Vec::new();
-    for load in [CoulombLoad::Total, CoulombLoad::Elastic] {
-        cfg.contact.coulomb_load = load;
-        let dir = RunDir::create(&tmp.path().join(format!("{load:?}"))).unwrap();
-        let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
-        assert_eq!(s.finished, Finished::Completed);
-        csv.push(std::fs::read_to_string(dir.root().join("energy.csv")).unwrap());
-    }
+    let csv: Vec<String> = [CoulombLoad::Total, CoulombLoad::Elastic]
+        .into_iter()
+        .map(|load| {
+            cfg.contact.coulomb_load = load;
+            energy_history(&cfg, &tmp.path().join(format!("{load:?}")))
+        })
+        .collect();
     assert_ne!(csv[0], csv[1], "the Coulomb load changed nothing");
     // Adhesive laws choose their own Coulomb force: the key is an error there, naming it.
     cfg.contact.normal = NormalKind::Jkr;
