@@ -188,24 +188,28 @@ fn tangential_history_rule_is_selectable_from_the_scene() {
     assert!(toml::from_str::<ContactConfig>("tangential = \"deresiewicz\"").is_err());
     // The choice reaches the engine: the same pour with the incremental rescaled rule gives another
     // energy history than the default (the particles stick and slide on the floor and on each other).
-    let tmp = tempfile::tempdir().unwrap();
-    let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
-    let csv: Vec<String> = [TangentialKind::Mindlin, TangentialKind::MindlinRescaleForce]
-        .into_iter()
-        .map(|kind| {
-            cfg.contact.tangential = kind;
-            energy_history(&cfg, &tmp.path().join(format!("{kind:?}")))
-        })
-        .collect();
-    assert_ne!(csv[0], csv[1], "the tangential rule changed nothing");
+    assert_pour_differs(
+        "the tangential rule",
+        [&|c| c.contact.tangential = TangentialKind::Mindlin, &|c| {
+            c.contact.tangential = TangentialKind::MindlinRescaleForce
+        }],
+    );
 }
 
-/// Runs `cfg` to completion into `dir` and returns its `energy.csv`.
-fn energy_history(cfg: &SceneConfig, dir: &Path) -> String {
-    let dir = RunDir::create(dir).unwrap();
-    let s = run(cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
-    assert_eq!(s.finished, Finished::Completed);
-    std::fs::read_to_string(dir.root().join("energy.csv")).unwrap()
+/// Runs the pour on the STL floor once with each setting and asserts that the two energy histories
+/// (`energy.csv`) differ: the option named `what` reaches the engine.
+fn assert_pour_differs(what: &str, settings: [&dyn Fn(&mut SceneConfig); 2]) {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut csv = Vec::new();
+    for (k, set) in settings.iter().enumerate() {
+        let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+        set(&mut cfg);
+        let dir = RunDir::create(&tmp.path().join(format!("run{k}"))).unwrap();
+        let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+        assert_eq!(s.finished, Finished::Completed);
+        csv.push(std::fs::read_to_string(dir.root().join("energy.csv")).unwrap());
+    }
+    assert_ne!(csv[0], csv[1], "{what} changed nothing");
 }
 
 #[test]
@@ -219,17 +223,16 @@ fn coulomb_load_is_selectable_from_the_scene_and_refused_for_adhesive_laws() {
     assert!(toml::from_str::<ContactConfig>("coulomb_load = \"normal\"").is_err());
     // The choice reaches the engine: damped contacts sliding on the floor and on each other feel another
     // friction cap, so the energy history differs.
+    assert_pour_differs(
+        "the Coulomb load",
+        [&|c| c.contact.coulomb_load = CoulombLoad::Total, &|c| {
+            c.contact.coulomb_load = CoulombLoad::Elastic
+        }],
+    );
+    // Adhesive laws choose their own Coulomb force: the key is an error there, naming it.
     let tmp = tempfile::tempdir().unwrap();
     let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
-    let csv: Vec<String> = [CoulombLoad::Total, CoulombLoad::Elastic]
-        .into_iter()
-        .map(|load| {
-            cfg.contact.coulomb_load = load;
-            energy_history(&cfg, &tmp.path().join(format!("{load:?}")))
-        })
-        .collect();
-    assert_ne!(csv[0], csv[1], "the Coulomb load changed nothing");
-    // Adhesive laws choose their own Coulomb force: the key is an error there, naming it.
+    cfg.contact.coulomb_load = CoulombLoad::Elastic;
     cfg.contact.normal = NormalKind::Jkr;
     let errs = Checker::run(&cfg, None).unwrap_err();
     let e = errs.iter().find(|e| e.key == "contact.coulomb_load").unwrap_or_else(|| panic!("{errs:?}"));
