@@ -19,6 +19,7 @@
 
 pub mod bench;
 pub mod boundary;
+mod candidates;
 pub mod drag;
 pub mod eos;
 pub mod error;

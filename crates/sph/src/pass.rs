@@ -19,6 +19,7 @@
 //! enter the same pressure, artificial-viscosity and continuity terms with the wall velocity, the laminar
 //! term with the no-slip dummy velocity, and the Akinci adhesion force.
 
+use crate::candidates::{Candidates, Coords32View, BATCH};
 use crate::kernel::{AkinciSplines, Dim, Kernel, KernelKind};
 use crate::neighbours::NeighbourGrid;
 use crate::params::DragParams;
@@ -103,6 +104,8 @@ pub(crate) struct FluidSet<'a> {
     pub pr: &'a [f64],
     /// 1/ρ \[m³/kg\].
     pub irho: &'a [f64],
+    /// Single-precision copy of `pos` for the cut-off test.
+    pub c32: Coords32View<'a>,
     /// Akinci surface normals (empty without surface tension).
     pub nrm: &'a [Vec3],
     pub grid: &'a NeighbourGrid,
@@ -127,6 +130,8 @@ pub(crate) struct WallSet<'a> {
     pub irho: &'a [f64],
     pub vol: &'a [f64],
     pub part: &'a [u16],
+    /// Single-precision copy of `pos` for the cut-off test.
+    pub c32: Coords32View<'a>,
     pub grid: &'a NeighbourGrid,
     /// Per real fluid particle: 1 when some entry lies within the cut-off, as found by this step's
     /// [`wall_state`] (symmetric test, same pairs); the fluid pass then skips the wall query of the others.
@@ -324,7 +329,8 @@ pub(crate) fn wall_state(
                                 is_wet |= dn.abs() < wet_n && d.length_squared() - dn * dn < wet_t2;
                             }
                         };
-                        set.grid.for_each_run(xb, |run| cand.collect(xb, c.r2max, set.pos, run, &mut sum));
+                        let q = set.c32.query(xb, c.r2max);
+                        set.grid.for_each_run(xb, |run| cand.collect(&q, &set.c32, run, &mut sum));
                         sum(cand.take());
                     }
                     let (p, vv) = if sw > 0.0 {
@@ -612,8 +618,9 @@ fn pair_block<K: KernelFn, const EXTRA: bool>(
     for i in home {
         let xi = fl.pos[i];
         let mut st = PairState::new(fl, i, c);
+        let q = fl.c32.query(xi, c.r2max);
         fl.grid.for_each_run_after(xi, |run| {
-            cand.collect(xi, c.r2max, fl.pos, run.start.max(i + 1)..run.end, |list| {
+            cand.collect(&q, &fl.c32, run.start.max(i + 1)..run.end, |list| {
                 pairs += pair_list::<K, EXTRA>(kf, c, fl, list, &mut st, offset, out, &mut batch);
             });
         });
@@ -621,70 +628,6 @@ fn pair_block<K: KernelFn, const EXTRA: bool>(
         st.store(i - offset, out);
     }
     pairs
-}
-
-/// Branch-free collection of the neighbours of one point: the candidates of contiguous index ranges
-/// are tested against the squared cut-off, and every candidate's index is written to the next free slot
-/// of the list, which only advances when the candidate is within the cut-off (no unpredictable branch).
-struct Candidates {
-    list: [u32; BATCH],
-    n: usize,
-}
-
-impl Candidates {
-    fn new() -> Self {
-        Candidates { list: [0; BATCH], n: 0 }
-    }
-
-    /// Appends the indices `k` in `range` with `|x − pos[k]|² < r2max` \[m²\]; whenever the list is
-    /// full it is handed to `flush` and emptied.
-    #[inline(always)]
-    fn collect(
-        &mut self,
-        x: Vec3,
-        r2max: f64,
-        pos: &[Vec3],
-        range: std::ops::Range<usize>,
-        mut flush: impl FnMut(&[u32]),
-    ) {
-        let mut s = range.start;
-        while s < range.end {
-            if self.n == BATCH {
-                flush(&self.list);
-                self.n = 0;
-            }
-            // At most the free slots, so the loop below needs no capacity test.
-            let e = range.end.min(s + (BATCH - self.n));
-            let list = &mut self.list;
-            let mut n = self.n;
-            let mut test = |k: usize, p: &Vec3| {
-                // n < BATCH here; the mask only lets the compiler drop the bounds check.
-                list[n & (BATCH - 1)] = k as u32;
-                n += ((x - *p).length_squared() < r2max) as usize;
-            };
-            // Two candidates per iteration: the loop counter is a fifth of the work of one candidate.
-            let pairs = pos[s..e].chunks_exact(2);
-            let last = pairs.remainder();
-            let mut k = s;
-            for pq in pairs {
-                test(k, &pq[0]);
-                test(k + 1, &pq[1]);
-                k += 2;
-            }
-            if let Some(p) = last.first() {
-                test(k, p);
-            }
-            self.n = n;
-            s = e;
-        }
-    }
-
-    /// The neighbours collected since the last flush; empties the list.
-    #[inline(always)]
-    fn take(&mut self) -> &[u32] {
-        let n = std::mem::replace(&mut self.n, 0);
-        &self.list[..n]
-    }
 }
 
 /// Running sums of the home particle of [`pair_block`].
@@ -822,10 +765,6 @@ struct Batch {
     ci: [f32; BATCH],
     cj: [f32; BATCH],
 }
-
-/// Neighbours per batch (a power of two, see [`Candidates::collect`]).
-const BATCH: usize = 256;
-const _: () = assert!(BATCH.is_power_of_two());
 
 /// `n` (at most [`BATCH`]) rounded up to a multiple of 4, the lanes the compiler processes per iteration
 /// of the vectorised pair terms on baseline x86-64 (SSE2): the loop then ends without a scalar remainder.
@@ -1001,7 +940,8 @@ fn walls_batched(
         flush(list, batch, &mut acc, &mut d, &mut near);
         count += list.len() as u64;
     };
-    wl.grid.for_each_run(xi, |run| cand.collect(xi, c.r2max, wl.pos, run, &mut flush_count));
+    let q = wl.c32.query(xi, c.r2max);
+    wl.grid.for_each_run(xi, |run| cand.collect(&q, &wl.c32, run, &mut flush_count));
     flush_count(cand.take());
     (acc, d, near, count)
 }

@@ -20,6 +20,7 @@ use crate::boundary::{
     block_lattice, box_surface, mesh_samples, solid_samples, tank_lattice, Boundary, Faces, Frame, Sampling,
     Slip,
 };
+use crate::candidates::Coords32;
 use crate::error::SphError;
 use crate::fill::{fill_box, flood_fill, Clearance};
 use crate::fluid::{Fluid, PermuteScratch};
@@ -101,6 +102,10 @@ struct Work {
     perm_u: Vec<u32>,
     pr: Vec<f64>,
     irho: Vec<f64>,
+    /// Single-precision positions of the sorted fluid, ghosts and walls for the cut-off test.
+    c32: Coords32,
+    g_c32: Coords32,
+    w_c32: Coords32,
     nrm: Vec<Vec3>,
     acc_new: Vec<Vec3>,
     drho_new: Vec<f64>,
@@ -474,6 +479,9 @@ impl Simulation {
             let scratch = PermuteScratch { v3: &mut w.acc_new, f: &mut w.drho_new, u: &mut w.perm_u };
             self.fluid.permute(&w.perm_buf, scratch);
         }
+        let origin = self.coords_origin();
+        let w = &mut self.work;
+        w.c32.fill(&self.fluid.pos, origin);
         // Dry wall particles skip their fluid query.
         w.grid.build_reach();
         self.compute_pressure();
@@ -499,6 +507,7 @@ impl Simulation {
     /// Images of fluid particles within one support of a periodic face, shifted by the period.
     fn build_fluid_images(&mut self) {
         let support = self.kernel().support();
+        let origin = self.coords_origin();
         let w = &mut self.work;
         w.g_src.clear();
         w.g_pos.clear();
@@ -541,6 +550,7 @@ impl Simulation {
         w.g_tmp_v.clear();
         w.g_tmp_v.extend(perm.iter().map(|&i| w.g_pos[i as usize]));
         std::mem::swap(&mut w.g_pos, &mut w.g_tmp_v);
+        w.g_c32.fill(&w.g_pos, origin);
         self.gather_image_state();
     }
 
@@ -563,9 +573,15 @@ impl Simulation {
     fn build_wall_set(&mut self) {
         let support = self.kernel().support();
         let periodic = self.periodic.iter().any(|&p| p);
+        let origin = self.coords_origin();
         let w = &mut self.work;
         let b = &self.boundary;
-        if w.walls_built && !periodic && !b.any_moving() && w.w_src.len() == b.len() {
+        if w.walls_built
+            && !periodic
+            && !b.any_moving()
+            && w.w_src.len() == b.len()
+            && w.w_c32.origin() == origin
+        {
             return;
         }
         w.w_src.clear();
@@ -612,6 +628,7 @@ impl Simulation {
         w.w_vvisc.clear();
         w.w_vvisc.extend(perm.iter().map(|&i| w.w_pos[i as usize]));
         std::mem::swap(&mut w.w_pos, &mut w.w_vvisc);
+        w.w_c32.fill(&w.w_pos, origin);
         let n = w.w_src.len();
         w.w_vel.clear();
         w.w_vel.extend(w.w_src.iter().map(|&s| b.velocity(s as usize)));
@@ -627,6 +644,17 @@ impl Simulation {
         w.walls_built = true;
     }
 
+    /// Origin of the single-precision coordinates of the cut-off test: the lower corner of the domain
+    /// box (zero without one). Fixed for a run, so results do not depend on when it was resumed.
+    fn coords_origin(&self) -> Vec3 {
+        let min = self.domain.min;
+        if min.is_finite() {
+            min
+        } else {
+            Vec3::ZERO
+        }
+    }
+
     /// Read-only views of the fluid, its periodic images (both without surface normals) and the walls
     /// (with whatever wall state `work` holds) for the neighbour passes.
     fn views(&self) -> (FluidSet<'_>, FluidSet<'_>, WallSet<'_>) {
@@ -637,6 +665,7 @@ impl Simulation {
             rho: &self.fluid.rho,
             pr: &w.pr,
             irho: &w.irho,
+            c32: w.c32.view(),
             nrm: &[],
             grid: &w.grid,
         };
@@ -646,6 +675,7 @@ impl Simulation {
             rho: &w.g_rho,
             pr: &w.g_pr,
             irho: &w.g_irho,
+            c32: w.g_c32.view(),
             nrm: &[],
             grid: &w.g_grid,
         };
@@ -662,6 +692,7 @@ impl Simulation {
             irho: &w.w_irho,
             vol: &w.w_vol,
             part: &w.w_part,
+            c32: w.w_c32.view(),
             grid: &w.w_grid,
             touched: w.w_touched.as_slice(),
         };
@@ -1144,6 +1175,7 @@ impl Simulation {
             + b(&w.keep)
             + b(&w.perm_buf)
             + b(&w.perm_u)
+            + w.c32.bytes()
             + w.grid.bytes();
         let images = b(&w.g_src)
             + b(&w.g_pos)
@@ -1154,8 +1186,10 @@ impl Simulation {
             + b(&w.g_nrm)
             + b(&w.g_tmp_u)
             + b(&w.g_tmp_v)
+            + w.g_c32.bytes()
             + w.g_grid.bytes();
         let walls = self.boundary.bytes()
+            + w.w_c32.bytes()
             + b(&w.w_src)
             + b(&w.w_ghost)
             + b(&w.w_pos)
