@@ -175,30 +175,34 @@ impl Candidates {
                 flush(&self.list[..self.n]);
                 self.n = 0;
             }
-            // Whole groups that fit the free slots; the last group of the range may hold lanes past its
-            // end, which are masked out.
-            let groups = ((end - start).div_ceil(LANES)).min((BATCH - self.n) / LANES);
-            let stop = start + groups * LANES;
+            // At most as many candidates as the free slots hold in whole groups: the loops below then
+            // need no capacity test (a last, partial group writes four slots too).
+            let stop = end.min(start + ((BATCH - self.n) & !(LANES - 1)));
+            let whole = start + (stop - start) / LANES * LANES;
             let mut n = self.n;
             let list = &mut self.list;
-            let (gx, gy, gz) = (&xs[start..stop], &ys[start..stop], &zs[start..stop]);
             let mut k = glam::UVec4::splat(start as u32);
-            let full = (end - start).min(stop - start) / LANES;
-            let groups = gx.chunks_exact(LANES).zip(gy.chunks_exact(LANES)).zip(gz.chunks_exact(LANES));
-            for (g, ((cx, cy), cz)) in groups.enumerate() {
-                let mut m = q.mask(cx, cy, cz) as usize;
-                if g == full {
-                    // The last group of the range: lanes past its end are not candidates.
-                    m &= (1 << ((end - start) % LANES)) - 1;
-                }
-                // The selected indices, packed to the front, fill the next four slots; the count of
-                // them advances the list.
-                (k + glam::UVec4::from_array(PACKED[m])).write_to_slice(&mut list[n..n + LANES]);
+            let mut put = |m: u32, k: glam::UVec4| {
+                // The selected indices, packed to the front, fill the next four slots; their count
+                // advances the list.
+                (k + glam::UVec4::from_array(PACKED[m as usize])).write_to_slice(&mut list[n..n + LANES]);
                 n += (COUNTS >> (4 * m)) as usize & 0xf;
+            };
+            let groups = xs[start..whole]
+                .chunks_exact(LANES)
+                .zip(ys[start..whole].chunks_exact(LANES))
+                .zip(zs[start..whole].chunks_exact(LANES));
+            for ((cx, cy), cz) in groups {
+                put(q.mask(cx, cy, cz), k);
                 k += glam::UVec4::splat(LANES as u32);
             }
+            if whole < stop {
+                // Lanes past the end of the range are not candidates.
+                let g = whole..whole + LANES;
+                put(q.mask(&xs[g.clone()], &ys[g.clone()], &zs[g]) & ((1 << (stop - whole)) - 1), k);
+            }
             self.n = n;
-            start = stop.min(end);
+            start = stop;
         }
     }
 

@@ -310,7 +310,7 @@ pub(crate) fn wall_state(
                     let xs = xb + normal * c.wet_offset[part];
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
                     let mut is_wet = false;
-                    for (set, touched) in [(fl, wl.touched), (gh, &[][..])] {
+                    for (set, touched) in [(&fl, wl.touched), (&gh, &[][..])] {
                         // Neighbours collected without branching, then summed in the same order.
                         let mut sum = |list: &[u32]| {
                             for &j in list {
