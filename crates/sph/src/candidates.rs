@@ -2,7 +2,7 @@
 //! testing four candidates per instruction in single precision.
 //!
 //! Each set keeps, next to its double-precision positions, a single-precision copy in structure-of-arrays
-//! form ([`Coords32`], 12 bytes per particle), relative to an origin shared by every set of a step. The
+//! form ([`Coords32`], 12 bytes per particle), relative to an origin shared by every set of a run. The
 //! cut-off test runs on that copy four lanes wide (SSE2 on baseline x86-64), and the lanes' results
 //! become a bit mask, so the candidate loop has neither a branch per candidate nor a conversion. The pair
 //! terms still take their distances from the double-precision positions.
@@ -162,13 +162,9 @@ impl Candidates {
         mut flush: impl FnMut(&[u32]),
     ) {
         let Range { mut start, end } = range;
-        // Equal lengths, so that one bounds test of a range covers the three axes.
+        // Equal lengths, so that one bounds test of a range covers the three axes. Ranges come from the
+        // set's own cell list, filled from the same positions, so they lie within the coordinates.
         let len = set.x.len().min(set.y.len()).min(set.z.len());
-        if end + LANES - 1 > len {
-            // Ranges come from the set's own cell list; anything else is a caller's error.
-            debug_assert!(end == start, "candidate range {start}..{end} beyond the {len} coordinates");
-            return;
-        }
         let (xs, ys, zs) = (&set.x[..len], &set.y[..len], &set.z[..len]);
         while start < end {
             if self.n + LANES > BATCH {
