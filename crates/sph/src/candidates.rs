@@ -218,11 +218,9 @@ mod tests {
     /// every length modulo four, lists that overflow, and points far from the origin.
     #[test]
     fn collects_exactly_the_points_within_the_cut_off() {
-        let mut s = 7u64;
-        let mut rnd = move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use spatter_core::rng::RngExt;
+        let mut rng = spatter_core::rng::seeded(7, 0);
+        let mut rnd = move || rng.random::<f64>();
         let far = Vec3::new(250.0, -40.0, 3.0);
         let pts: Vec<Vec3> = (0..2000).map(|_| far + Vec3::new(rnd(), rnd(), rnd())).collect();
         let mut c32 = Coords32::default();
