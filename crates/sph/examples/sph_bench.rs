@@ -1,6 +1,7 @@
 //! One configuration of the SPH benchmark, for profiling:
-//! `cargo run --release -p spatter-sph --example sph_bench -- [n] [threads] [steps]`
-//! (n particles across the column width, default 46; 1 thread; 5 steps). Prints wall and CPU time
+//! `cargo run --release -p spatter-sph --example sph_bench -- [n] [threads] [steps] [h/dp]`
+//! (n particles across the column width, default 46; 1 thread; 5 steps; smoothing length over spacing,
+//! default that of the engine, 1.5 in 3D). Prints wall and CPU time
 //! (user + system of the process) per step, throughput and the wall time per phase of the step.
 //! `-- all` runs `bench::bench(true)` (the quick `spatter bench sph`), `-- full` the full one.
 
@@ -16,14 +17,27 @@ fn main() {
         }
         return;
     }
-    let args: Vec<usize> = raw.iter().filter_map(|a| a.parse().ok()).collect();
-    let n = args.first().copied().unwrap_or(46);
-    let threads = args.get(1).copied().unwrap_or(1);
-    let steps = args.get(2).copied().unwrap_or(5) as u64;
-    match spatter_sph::bench::run_case(n, threads, steps) {
+    let int = |k: usize, default: usize| -> usize {
+        raw.get(k).map_or(default, |a| {
+            a.parse().unwrap_or_else(|_| {
+                eprintln!("error: argument {} is {a:?}, expected a whole number", k + 1);
+                std::process::exit(2)
+            })
+        })
+    };
+    let (n, threads, steps) = (int(0, 46), int(1, 1), int(2, 5) as u64);
+    let h_over_dp = raw.get(3).map(|a| match a.parse::<f64>() {
+        Ok(r) if r.is_finite() && r >= 1.0 => r,
+        _ => {
+            eprintln!("error: argument 4 (h/dp) is {a:?}, expected a number of at least 1");
+            std::process::exit(2)
+        }
+    });
+    match spatter_sph::bench::run_case_with(n, threads, steps, h_over_dp) {
         Ok(r) => {
             let inter = r.interactions_per_particle * r.fluid_particles as f64 * r.steps as f64;
-            let cpu = r.cpu_seconds.unwrap_or(f64::NAN);
+            // The CPU clock ticks in 10 ms: a run shorter than a tick has no rate per CPU-second.
+            let cpu = r.cpu_seconds.filter(|&c| c > 0.0).unwrap_or(f64::NAN);
             println!(
                 "{} fluid + {} wall, {} thread(s), {} steps: {:.3} s/step wall, {:.3} CPU-s/step, {:.3e} interactions/s, {:.3e} interactions per CPU-s, {:.1} interactions per particle, {:.0} B/particle",
                 r.fluid_particles,

@@ -37,10 +37,20 @@ pub struct BenchResult {
 /// The dam break of the benchmark: column a × 2a × a (x, z, y) with `n` particles across a, in a tank
 /// 4a long and 2a high (open top).
 pub fn dam_break(n: usize) -> Simulation {
+    dam_break_with(n, None)
+}
+
+/// [`dam_break`] with the smoothing length `h_over_dp` × spacing instead of the default (1.5 in 3D,
+/// support 3 dp). `Some(1.0)` gives a support of 2 dp, the fixed support (4 particle radii) of
+/// SPlisHSPlasH, for the side-by-side comparison in `bench/sph/compare.sh`.
+pub fn dam_break_with(n: usize, h_over_dp: Option<f64>) -> Simulation {
     let dp = 0.005;
     let a = n as f64 * dp;
     let g = 9.81;
     let mut p = SphParams::water(Dim::Three, dp, 10.0 * (2.0 * g * 2.0 * a).sqrt());
+    if let Some(r) = h_over_dp {
+        p.h_over_dp = r;
+    }
     p.gravity = Vec3::new(0.0, 0.0, -g);
     let mut sim = Simulation::new(p);
     let open_top = [true, true, true, true, true, false];
@@ -58,12 +68,22 @@ pub fn dam_break(n: usize) -> Simulation {
 
 /// Times `steps` steps of the dam break on `threads` threads (after two warm-up steps).
 pub fn run_case(n: usize, threads: usize, steps: u64) -> Result<BenchResult, crate::SphError> {
+    run_case_with(n, threads, steps, None)
+}
+
+/// [`run_case`] of [`dam_break_with`]`(n, h_over_dp)`.
+pub fn run_case_with(
+    n: usize,
+    threads: usize,
+    steps: u64,
+    h_over_dp: Option<f64>,
+) -> Result<BenchResult, crate::SphError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| crate::SphError::Setup(format!("cannot start {threads} threads: {e}")))?;
     pool.install(|| {
-        let mut sim = dam_break(n);
+        let mut sim = dam_break_with(n, h_over_dp);
         sim.initialize()?;
         for _ in 0..2 {
             sim.step()?;
@@ -175,4 +195,29 @@ pub fn bench(quick: bool) -> Result<Vec<String>, crate::SphError> {
         r1.phase_ms.correct
     ));
     Ok(lines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// With h = dp the support is 2 dp, so a particle deep in a lattice has the 26 lattice points with
+    /// |k|² < 4 as neighbours (the 6 at exactly 2 dp lie on the support and are not counted), against 80
+    /// with |k|² < 9 at the default h = 1.5 dp; the column of the benchmark has surfaces and walls, so
+    /// its averages are compared with bounds around those counts.
+    #[test]
+    fn the_smoothing_length_option_sets_the_support() {
+        let s = dam_break_with(12, Some(1.0));
+        assert_eq!(s.params.h(), s.params.spacing);
+        let d = dam_break(12);
+        assert_eq!(d.params.h(), 1.5 * d.params.spacing);
+        let narrow = run_case_with(12, 1, 1, Some(1.0)).unwrap();
+        let wide = run_case(12, 1, 1).unwrap();
+        assert!(
+            (18.0..30.0).contains(&narrow.interactions_per_particle),
+            "{}",
+            narrow.interactions_per_particle
+        );
+        assert!((60.0..95.0).contains(&wide.interactions_per_particle), "{}", wide.interactions_per_particle);
+    }
 }
