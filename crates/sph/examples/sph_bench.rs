@@ -17,19 +17,26 @@ fn main() {
         }
         return;
     }
+    const NAMES: [&str; 4] = ["n (particles across the column)", "threads", "steps", "h/dp"];
     let int = |k: usize, default: usize| -> usize {
-        raw.get(k).map_or(default, |a| {
-            a.parse().unwrap_or_else(|_| {
-                eprintln!("error: argument {} is {a:?}, expected a whole number", k + 1);
+        raw.get(k).map_or(default, |a| match a.parse::<usize>() {
+            Ok(v) if v >= 1 => v,
+            _ => {
+                eprintln!(
+                    "error: argument {} ({}) is {a:?}, expected a whole number of at least 1",
+                    k + 1,
+                    NAMES[k]
+                );
                 std::process::exit(2)
-            })
+            }
         })
     };
     let (n, threads, steps) = (int(0, 46), int(1, 1), int(2, 5) as u64);
+    // The range scenario files accept for `h_over_dp` (`scene/config.rs`).
     let h_over_dp = raw.get(3).map(|a| match a.parse::<f64>() {
-        Ok(r) if r.is_finite() && r >= 1.0 => r,
+        Ok(r) if (1.0..=4.0).contains(&r) => r,
         _ => {
-            eprintln!("error: argument 4 (h/dp) is {a:?}, expected a number of at least 1");
+            eprintln!("error: argument 4 ({}) is {a:?}, expected a number from 1 to 4", NAMES[3]);
             std::process::exit(2)
         }
     });
@@ -39,13 +46,14 @@ fn main() {
             // The CPU clock ticks in 10 ms: a run shorter than a tick has no rate per CPU-second.
             let cpu = r.cpu_seconds.filter(|&c| c > 0.0).unwrap_or(f64::NAN);
             println!(
-                "{} fluid + {} wall, {} thread(s), {} steps: {:.3} s/step wall, {:.3} CPU-s/step, {:.3e} interactions/s, {:.3e} interactions per CPU-s, {:.1} interactions per particle, {:.0} B/particle",
+                "{} fluid + {} wall, {} thread(s), {} steps: {:.3} s/step wall, {:.3} CPU-s/step, {:.4e} particle-steps/s, {:.3e} interactions/s, {:.3e} interactions per CPU-s, {:.1} interactions per particle, {:.0} B/particle",
                 r.fluid_particles,
                 r.wall_particles,
                 r.threads,
                 r.steps,
                 r.seconds / r.steps as f64,
                 cpu / r.steps as f64,
+                r.particle_steps_per_s,
                 r.interactions_per_s,
                 inter / cpu,
                 r.interactions_per_particle,

@@ -202,9 +202,10 @@ mod tests {
     use super::*;
 
     /// With h = dp the support is 2 dp, so a particle deep in a lattice has the 26 lattice points with
-    /// |k|² < 4 as neighbours (the 6 at exactly 2 dp lie on the support and are not counted), against 80
-    /// with |k|² < 9 at the default h = 1.5 dp; the column of the benchmark has surfaces and walls, so
-    /// its averages are compared with bounds around those counts.
+    /// 0 < |k|² < 4 as neighbours (the 6 at exactly 2 dp lie on the support and are not counted), against
+    /// 92 with 0 < |k|² < 9 at the default h = 1.5 dp; the small column here has surfaces and walls, so
+    /// its averages (24.9 and 86.7 interactions per particle) are checked against bounds around those
+    /// counts that exclude each other.
     #[test]
     fn the_smoothing_length_option_sets_the_support() {
         let s = dam_break_with(12, Some(1.0));
