@@ -68,10 +68,18 @@ pub struct RunSummary {
     pub headline: Vec<String>,
     /// Labelled output files (pictures, tables) the user will want to open.
     pub artifacts: Vec<(String, PathBuf)>,
+    /// Named scalar results (name carries the unit, e.g. `stick_fraction`, `total_J`): the columns a study's
+    /// results table gets for this run, one row per case.
+    pub scalars: Vec<(String, f64)>,
 }
 
 impl RunSummary {
     pub fn new(finished: Finished) -> Self {
-        RunSummary { finished, headline: Vec::new(), artifacts: Vec::new() }
+        RunSummary { finished, headline: Vec::new(), artifacts: Vec::new(), scalars: Vec::new() }
+    }
+
+    /// Records the scalar result `name` (unit in the name) for study tables.
+    pub fn scalar(&mut self, name: &str, value: f64) {
+        self.scalars.push((name.to_owned(), value));
     }
 }

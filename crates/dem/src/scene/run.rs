@@ -445,6 +445,18 @@ fn summary<L: ContactLaw>(
         e.dissipated,
         e.total()
     ));
+    for (name, value) in [
+        ("particles", sim.particles.len() as f64),
+        ("removed", sim.removed_count() as f64),
+        ("t_end_s", sim.time()),
+        ("kinetic_J", e.kinetic),
+        ("rotational_J", e.rotational),
+        ("elastic_J", e.elastic),
+        ("dissipated_J", e.dissipated),
+        ("budget_total_J", e.total()),
+    ] {
+        s.scalar(name, value);
+    }
     s.headline.push(format!(
         "contacts: {} particle-particle, {} particle-wall; time step {:.1} % of the Rayleigh time; {:.0} bytes \
          of state per particle",
