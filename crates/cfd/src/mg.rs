@@ -11,8 +11,8 @@
 //! distance doubles); restriction sums the residuals of the children and prolongation injects the coarse
 //! correction into them (additive-correction multigrid, Hutchinson & Raithby 1986). The smoother is
 //! red–black Gauss–Seidel, run red→black before and black→red after the coarse correction so that the
-//! V-cycle is a symmetric operator, as conjugate gradients requires; the coarsest grid (≤ 512 cells) is
-//! solved exactly by a dense Cholesky factorisation. A singular operator (no Dirichlet face: closed
+//! V-cycle is a symmetric operator, as conjugate gradients requires; the coarsest grid is
+//! solved exactly by a dense Cholesky factorisation (≤ 64 cells). A singular operator (no Dirichlet face: closed
 //! cavities) is made definite on the coarsest grid by adding the rank-one term (D̄/n)·11ᵀ, which selects
 //! the zero-mean solution.
 //!
@@ -350,7 +350,7 @@ pub struct Multigrid {
 }
 
 /// Coarsening stops at or below this many cells.
-const COARSEST_CELLS: usize = 512;
+const COARSEST_CELLS: usize = 64;
 
 impl Multigrid {
     /// Builds the hierarchy for `op`.
