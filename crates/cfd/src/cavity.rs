@@ -58,12 +58,12 @@ pub fn ghia(re: u32) -> Option<(Profile, Profile)> {
 /// A unit square cavity (2D: one cell across z with slip sides) with `n × n` cells, lid speed 1 at y = 1,
 /// ν = 1/Re. `beta` > 0 clusters the cells towards the walls (tanh map).
 pub fn square_cavity(n: usize, re: f64, beta: f64, numerics: Numerics) -> Result<Flow, FlowError> {
-    let ax = Axis::clustered(0.0, 1.0, n, beta).map_err(|e| FlowError::Boundaries(e.to_string()))?;
+    let ax = Axis::clustered(0.0, 1.0, n, beta).map_err(|e| FlowError::Setup(e.to_string()))?;
     let grid = Grid::new(
         [ax.clone(), ax, Axis::uniform(0.0, 1.0 / n as f64, 1).expect("one cell")],
         Mode::Cartesian,
     )
-    .map_err(|e| FlowError::Boundaries(e.to_string()))?;
+    .map_err(|e| FlowError::Setup(e.to_string()))?;
     let wall = Boundary::Wall { velocity_m_s: [0.0; 3] };
     let lid = Boundary::Wall { velocity_m_s: [1.0, 0.0, 0.0] };
     let bc = [wall.clone(), wall.clone(), wall, lid, Boundary::Slip, Boundary::Slip];

@@ -25,6 +25,7 @@ pub mod pcg;
 pub mod reduce;
 pub mod solid;
 pub mod solver;
+pub mod validation;
 
 pub use bc::{Boundary, TimeTable};
 pub use grid::{Axis, Grid, Mode};
