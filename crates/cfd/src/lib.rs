@@ -17,6 +17,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bc;
+pub mod bench;
 pub mod cavity;
 pub mod grid;
 pub mod mg;
