@@ -3,6 +3,7 @@
 //! * [`grid`] — axes (uniform, geometric, tanh-clustered), the padded layout, metric factors, and the
 //!   3D Cartesian and 2D axisymmetric (r, z) modes;
 //! * [`solid`] — blocked cells from analytic shapes (box, plate, cylinder, pipe wall) and closed STL/OBJ;
+//! * [`regions`] — connected fluid regions and the mass balance each must satisfy;
 //! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
 //! * [`solver`] — the projection method: Adams–Bashforth predictor, pressure correction, checks;
@@ -24,6 +25,7 @@ pub mod mg;
 pub mod momentum;
 pub mod pcg;
 pub mod reduce;
+pub mod regions;
 pub mod solid;
 pub mod solver;
 pub mod validation;

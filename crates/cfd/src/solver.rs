@@ -87,6 +87,8 @@ pub enum FlowError {
     Setup(String),
     #[error("inconsistent boundaries: {0}")]
     Boundaries(String),
+    #[error("mass balance: {0}")]
+    MassBalance(String),
     #[error("the pressure solver did not converge at step {step}: relative residual {residual:.2e} after {iterations} iterations")]
     Pressure { step: u64, residual: f64, iterations: usize },
 }
@@ -153,6 +155,15 @@ impl Flow {
                 )));
             }
         }
+        if blocked.len() != l.len() {
+            return Err(FlowError::Setup(format!(
+                "{} blocked flags for a grid of {} padded cells (use solid::blocked_cells)",
+                blocked.len(),
+                l.len()
+            )));
+        }
+        let regions = crate::regions::find(&grid, &bc, &blocked);
+        crate::regions::check_mass_balance(&grid, &bc, &regions).map_err(FlowError::MassBalance)?;
         let n = l.len();
         let fluid_cell = |q: [usize; 3]| l.interior(q) && !blocked[l.at(q[0], q[1], q[2])];
         let mut kind = [vec![FIXED; n], vec![FIXED; n], vec![FIXED; n]];
