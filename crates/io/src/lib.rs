@@ -3,7 +3,7 @@
 //! * [`run`] — the run folder, the context a job runs in and the summary it returns;
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
-//! * [`vtr`] — VTK XML rectilinear grids (structured flow fields) and a strict reader for them;
+//! * [`vtr`] — VTK XML rectilinear grids (structured flow fields);
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
 //! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
 //! * [`plot`] — PNG/SVG charts and mesh colour maps;
