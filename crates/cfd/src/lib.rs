@@ -10,6 +10,7 @@
 //! * [`mg`] — geometric multigrid V-cycle for the pressure operator;
 //! * [`pcg`] — conjugate gradients preconditioned by that V-cycle;
 //! * [`reduce`] — parallel plane loops and thread-count-independent sums;
+//! * [`output`] — cell fields as `.vtr`, probes and slices for pictures;
 //! * [`cavity`] — the lid-driven cavity and the tables of Ghia, Ghia & Shin (1982).
 //!
 //! Everything is SI. The solver works in kinematic pressure p/ρ internally and reports pascals.
@@ -23,6 +24,7 @@ pub mod cavity;
 pub mod grid;
 pub mod mg;
 pub mod momentum;
+pub mod output;
 pub mod pcg;
 pub mod reduce;
 pub mod regions;
