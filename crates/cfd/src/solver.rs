@@ -624,6 +624,11 @@ impl Flow {
 
     /// Velocity at point x by trilinear interpolation of each staggered component \[m/s\]; `None` outside.
     pub fn velocity_at(&self, x: [f64; 3]) -> Option<[f64; 3]> {
+        self.velocity_at_nodes(&self.state.u, x)
+    }
+
+    /// Like [`Flow::velocity_at`] for other velocity nodes `nodes` on this grid (an earlier state).
+    pub fn velocity_at_nodes(&self, nodes: &[Vec<f64>; 3], x: [f64; 3]) -> Option<[f64; 3]> {
         let l = self.grid.layout;
         for a in 0..3 {
             if !(x[a] >= self.grid.axes[a].lo() && x[a] <= self.grid.axes[a].hi()) {
@@ -644,7 +649,7 @@ impl Flow {
                 base[a] = p;
                 w[a] = t;
             }
-            let u = &self.state.u[comp];
+            let u = &nodes[comp];
             let mut v = 0.0;
             for dk in 0..2 {
                 for dj in 0..2 {

@@ -1,4 +1,5 @@
-//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
+//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes, flow scenes.
 
+pub mod cfd;
 pub mod deposition;
 pub mod snow;

@@ -1,0 +1,154 @@
+//! The `flow` kind end to end: `examples/flow_cavity.toml` at a reduced size runs to the end and writes its
+//! files; a stopped and resumed run writes the same files byte for byte; bad input is refused with the key,
+//! boundary or cell named.
+
+use spatter_core::control::{Finished, StopAfterPolls, Unattended};
+use spatter_io::run::{RunContext, RunDir};
+use std::path::Path;
+
+const CAVITY: &str = include_str!("../../../examples/flow_cavity.toml");
+
+/// The example on a 16² grid for 2 s, without the early steady stop.
+fn small_cavity() -> String {
+    let t = CAVITY
+        .replace("cells = 48, cluster = 0.5", "cells = 16")
+        .replace("end_time_s = 40.0", "end_time_s = 2.0")
+        .replace("steady_rate_m_s2 = 1e-4", "")
+        .replace("field_interval_s = 5.0", "field_interval_s = 0.5")
+        .replace("sample_interval_s = 0.5", "sample_interval_s = 0.1");
+    assert!(
+        t.contains("cells = 16") && t.contains("end_time_s = 2.0") && t.contains("field_interval_s = 0.5")
+    );
+    t
+}
+
+fn load(dir: &Path, text: &str) -> Result<spatter_scenario::Loaded, String> {
+    let p = dir.join("flow.toml");
+    std::fs::write(&p, text).unwrap();
+    spatter_scenario::load(&p).map_err(|e| e.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("\n"))
+}
+
+fn run(
+    scenario: &spatter_scenario::Loaded,
+    out: &Path,
+    control: &dyn spatter_core::control::RunControl,
+    resume: bool,
+) -> Result<spatter_io::run::RunSummary, String> {
+    let dir = RunDir::create(out).unwrap();
+    scenario.scenario.run(&RunContext { dir: &dir, control, resume }).map_err(|e| e.to_string())
+}
+
+#[test]
+fn the_cavity_example_runs_and_a_resumed_run_writes_the_same_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = load(tmp.path(), &small_cavity()).unwrap();
+    assert_eq!(sc.scenario.kind(), "flow");
+    let whole = tmp.path().join("whole");
+    let s = run(&sc, &whole, &Unattended, false).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    let scalar = |n: &str| s.scalars.iter().find(|(k, _)| k == n).map(|(_, v)| *v).unwrap();
+    assert!((scalar("t_end_s") - 2.0).abs() < 1e-12);
+    // After 2 s the lid has set the fluid turning: the fastest cell centre, half a cell (1/32 m) below
+    // the lid, moves at most at the lid speed, the centre much slower.
+    let speed = scalar("max_speed_m_s");
+    assert!(speed > 0.6 && speed < 1.0, "{speed}");
+    assert!(scalar("probe_centre_ux_m_s").abs() < 0.3);
+    assert!(scalar("net_outflow_m3_s").abs() < 1e-12, "closed cavity: no net flux");
+    assert!(scalar("ghia_max_du").is_finite() && scalar("ghia_max_dv").is_finite());
+    for f in ["series.csv", "probes.csv", "fields.pvd", "speed.png", "centreline_u.png", "centreline_v.png"] {
+        assert!(whole.join(f).is_file(), "{f} missing");
+    }
+    let vtrs = std::fs::read_dir(whole.join("fields")).unwrap().count();
+    assert_eq!(vtrs, 5, "t = 0, 0.5, 1, 1.5, 2 s");
+    let pvd = std::fs::read_to_string(whole.join("fields.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 5);
+    let probes = std::fs::read_to_string(whole.join("probes.csv")).unwrap();
+    assert!(probes.starts_with("t_s,centre_ux_m_s,centre_uy_m_s,centre_uz_m_s,centre_p_Pa,below_lid_ux_m_s"));
+    assert_eq!(probes.lines().count(), 1 + 21, "header and t = 0, 0.1, …, 2 s");
+
+    // Stop after 150 polls (between two steps, mid-run), then resume.
+    let parts = tmp.path().join("parts");
+    let s = run(&sc, &parts, &StopAfterPolls::new(150), false).unwrap();
+    assert_eq!(s.finished, Finished::Interrupted);
+    assert!(parts.join("checkpoint.bin").is_file());
+    let s = run(&sc, &parts, &Unattended, true).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    assert!(!parts.join("checkpoint.bin").exists(), "a finished run removes its checkpoint");
+    let mut files =
+        vec!["series.csv".to_owned(), "probes.csv".into(), "fields.pvd".into(), "centrelines.csv".into()];
+    files.extend((0..5).map(|k| format!("fields/fields_{k:05}.vtr")));
+    for f in files {
+        let (a, b) = (std::fs::read(whole.join(&f)).unwrap(), std::fs::read(parts.join(&f)).unwrap());
+        assert!(a == b, "{f} differs between the uninterrupted and the resumed run");
+    }
+}
+
+/// The message of the first load error of `text`.
+fn load_error(text: &str) -> String {
+    let tmp = tempfile::tempdir().unwrap();
+    load(tmp.path(), text).err().unwrap_or_else(|| panic!("accepted:\n{text}"))
+}
+
+fn run_error(text: &str) -> String {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = load(tmp.path(), text).unwrap();
+    run(&sc, &tmp.path().join("out"), &Unattended, false).err().unwrap_or_else(|| panic!("ran:\n{text}"))
+}
+
+#[test]
+fn bad_flow_input_is_refused_with_the_key_boundary_or_cell_named() {
+    let base = small_cavity();
+    // An inlet table whose times go backwards: located at the key.
+    let e = load_error(&base.replace(
+        "x_min = { type = \"wall\" }",
+        "x_min = { type = \"inlet\", velocity_m_s = [1.0, 0.0, 0.0], table = { t_s = [0.0, 2.0, 1.0], factor = [0.0, 1.0, 1.0] } }",
+    ));
+    assert!(e.contains("boundaries.x_min.table.t_s") && e.contains("increase strictly"), "{e}");
+    assert!(e.contains("flow.toml:"), "located in the file: {e}");
+    // A grid far beyond memory: refused before anything is allocated.
+    let e = load_error(&base.replace(
+        "z = { min_m = 0.0, max_m = 0.02, cells = 1 }",
+        "z = { min_m = 0.0, max_m = 0.02, cells = 1 }\nmax_memory_gb = 0.0001",
+    ));
+    assert!(
+        e.contains("grid.x.cells") && e.contains("needs about") && e.contains("grid.max_memory_gb"),
+        "{e}"
+    );
+    let e = load_error(&base.replace("cells = 1 }", "cells = 10000000 }").replace(
+        "x = { min_m = 0.0, max_m = 1.0, cells = 16 }",
+        "x = { min_m = 0.0, max_m = 1.0, cells = 10000000 }",
+    ));
+    assert!(e.contains("grid.x.cells"), "{e}");
+    // An unknown key.
+    let e = load_error(&base.replace("courant = 0.5", "courant = 0.5\ncfl = 0.5"));
+    assert!(e.contains("cfl"), "{e}");
+    // An inlet with no outlet anywhere: the mass balance names the inlet and the region.
+    let e = run_error(&base.replace(
+        "x_min = { type = \"wall\" }",
+        "x_min = { type = \"inlet\", velocity_m_s = [1.0, 0.0, 0.0] }",
+    ));
+    assert!(
+        e.contains("inlet x_min")
+            && e.contains("fluid region 1")
+            && e.contains("no side of the grid is an outlet"),
+        "{e}"
+    );
+    // A fixed step far above the stable one: the blow-up names the step and the cell.
+    let e = run_error(&base.replace("courant = 0.5", "courant = 0.5\ndt_s = 0.2"));
+    assert!(e.contains("Courant number") && e.contains("in cell ("), "{e}");
+    // A probe outside the grid.
+    let e = run_error(&base.replace("at_m = [0.5, 0.9, 0.01]", "at_m = [0.5, 1.9, 0.01]"));
+    assert!(e.contains("output.probes[1]") && e.contains("below_lid"), "{e}");
+    // An open STL solid is named with its index and file.
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cube = spatter_core::shapes::box_mesh(spatter_core::Aabb::new(
+        spatter_core::Vec3::new(0.4, 0.4, -0.1),
+        spatter_core::Vec3::new(0.6, 0.6, 0.1),
+    ));
+    cube.triangles.pop();
+    std::fs::write(tmp.path().join("open.stl"), cube.to_binary_stl()).unwrap();
+    let text = format!("{base}\n[[solids]]\nshape = \"mesh\"\nfile = \"open.stl\"\n");
+    let sc = load(tmp.path(), &text).unwrap();
+    let e = run(&sc, &tmp.path().join("out"), &Unattended, false).err().unwrap();
+    assert!(e.contains("solids[0]") && e.contains("open.stl") && e.contains("not closed"), "{e}");
+}
