@@ -6,6 +6,7 @@
 //! * [`regions`] — connected fluid regions and the mass balance each must satisfy;
 //! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
+//! * [`turbulence`] — the standard k–ε model with wall functions;
 //! * [`solver`] — the projection method: Adams–Bashforth predictor, pressure correction, checks;
 //! * [`mg`] — geometric multigrid V-cycle for the pressure operator;
 //! * [`pcg`] — conjugate gradients preconditioned by that V-cycle;
@@ -30,6 +31,7 @@ pub mod reduce;
 pub mod regions;
 pub mod solid;
 pub mod solver;
+pub mod turbulence;
 pub mod validation;
 
 pub use bc::{Boundary, TimeTable};

@@ -63,6 +63,8 @@ pub struct State {
     /// Explicit terms of the previous step, for Adams–Bashforth.
     h_old: [Vec<f64>; 3],
     dt_old: f64,
+    /// k and ε when a turbulence model runs.
+    pub turbulence: Option<crate::turbulence::TurbState>,
 }
 
 /// Why a step failed.
@@ -112,6 +114,8 @@ pub struct Flow {
     pub blocked: Vec<bool>,
     /// Body acceleration at the velocity nodes \[m/s²\] (actuator disks, particles), if any.
     pub force: Option<[Vec<f64>; 3]>,
+    /// The k–ε model, when enabled ([`Flow::enable_k_epsilon`]).
+    pub turbulence: Option<crate::turbulence::Turbulence>,
     kind: [Vec<u8>; 3],
     /// Nodes set from neighbours after every update: (node, fluid neighbours to mirror).
     solid_nodes: [Vec<(usize, Vec<usize>)>; 3],
@@ -238,7 +242,15 @@ impl Flow {
         let centre_ops = [0, 1, 2].map(|a| DirOps::centre(&grid.metric[a]));
         let face_ops = [0, 1, 2].map(|a| DirOps::face(&grid.metric[a]));
         let zeros = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let state = State { t: 0.0, step: 0, u: zeros(), p: vec![0.0; n], h_old: zeros(), dt_old: 0.0 };
+        let state = State {
+            t: 0.0,
+            step: 0,
+            u: zeros(),
+            p: vec![0.0; n],
+            h_old: zeros(),
+            dt_old: 0.0,
+            turbulence: None,
+        };
         let mut f = Flow {
             grid,
             fluid,
@@ -247,6 +259,7 @@ impl Flow {
             state,
             blocked,
             force: None,
+            turbulence: None,
             kind,
             solid_nodes,
             outlet_nodes,
@@ -289,6 +302,16 @@ impl Flow {
             })
             .sum();
         (8 * n + bytes + lists) as u64 + self.pcg.heap_bytes()
+    }
+
+    /// Switches on the standard k–ε model with wall functions ([`crate::turbulence`]), starting from the
+    /// inlet turbulence everywhere. Call before the first step.
+    pub fn enable_k_epsilon(&mut self, model: crate::turbulence::KEpsilon) {
+        let mut t = crate::turbulence::Turbulence::new(model, &self.grid, &self.bc, &self.blocked);
+        let st = t.initial_state(&self.grid, &self.bc);
+        t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, &st);
+        self.state.turbulence = Some(st);
+        self.turbulence = Some(t);
     }
 
     /// Number of multigrid levels of the pressure solver.
@@ -372,8 +395,10 @@ impl Flow {
         }
     }
 
-    /// Explicit terms H of component `A` at its active nodes into `out`.
-    fn explicit_terms<const A: usize>(&self, out: &mut [f64]) {
+    /// Explicit terms H of component `A` at its active nodes into `out`; with `TURB` the viscosity of
+    /// each control-volume face is the effective viscosity of the turbulence model (the laminar path
+    /// keeps its arithmetic, so laminar results are unchanged bit for bit).
+    fn explicit_terms<const A: usize, const TURB: bool>(&self, out: &mut [f64]) {
         let l = self.grid.layout;
         let s = l.s;
         let u = &self.state.u;
@@ -386,6 +411,10 @@ impl Flow {
         let hoop = A == 0 && self.grid.mode == Mode::Axisymmetric;
         let rf = &self.grid.metric[0].xf;
         let force = self.force.as_ref().map(|f| &f[A]);
+        let nu_eff: &[f64] = match (&self.turbulence, TURB) {
+            (Some(t), true) => &t.nu_eff,
+            _ => &[],
+        };
         for_planes(&l, out, |k, plane| {
             let base = k * s[2];
             for j in GHOST..GHOST + l.n[1] {
@@ -422,12 +451,33 @@ impl Flow {
                             face_value(scheme, pe, pc, pw)
                         };
                         conv += fp * vp * (plus - pc) - fm * vm * (minus - pc);
-                        diff += fp * o.hp[qd] * (pe - pc) - fm * o.hm[qd] * (pc - pw);
+                        if TURB {
+                            // Face viscosities: cell centres along A, edge averages across.
+                            let sa = s[A];
+                            let (np, nm) = if d == A {
+                                (nu_eff[c + sa], nu_eff[c])
+                            } else {
+                                (
+                                    0.25 * (nu_eff[c]
+                                        + nu_eff[c + sa]
+                                        + nu_eff[c + sd]
+                                        + nu_eff[c + sa + sd]),
+                                    0.25 * (nu_eff[c]
+                                        + nu_eff[c + sa]
+                                        + nu_eff[c - sd]
+                                        + nu_eff[c + sa - sd]),
+                                )
+                            };
+                            diff += fp * o.hp[qd] * (pe - pc) * np - fm * o.hm[qd] * (pc - pw) * nm;
+                        } else {
+                            diff += fp * o.hp[qd] * (pe - pc) - fm * o.hm[qd] * (pc - pw);
+                        }
                     }
-                    let mut h = nu * diff - conv;
+                    let mut h = if TURB { diff - conv } else { nu * diff - conv };
                     if hoop {
                         let r = rf[i];
-                        h -= nu * pc / (r * r);
+                        let nu_node = if TURB { 0.5 * (nu_eff[c] + nu_eff[c + 1]) } else { nu };
+                        h -= nu_node * pc / (r * r);
                     }
                     if let Some(f) = force {
                         h += f[c];
@@ -443,10 +493,18 @@ impl Flow {
         let l = self.grid.layout;
         let s = l.s;
         let mut h_new = std::mem::take(&mut self.h_new);
-        self.explicit_terms::<0>(&mut h_new[0]);
-        self.explicit_terms::<1>(&mut h_new[1]);
-        if self.grid.mode == Mode::Cartesian {
-            self.explicit_terms::<2>(&mut h_new[2]);
+        if self.turbulence.is_some() {
+            self.explicit_terms::<0, true>(&mut h_new[0]);
+            self.explicit_terms::<1, true>(&mut h_new[1]);
+            if self.grid.mode == Mode::Cartesian {
+                self.explicit_terms::<2, true>(&mut h_new[2]);
+            }
+        } else {
+            self.explicit_terms::<0, false>(&mut h_new[0]);
+            self.explicit_terms::<1, false>(&mut h_new[1]);
+            if self.grid.mode == Mode::Cartesian {
+                self.explicit_terms::<2, false>(&mut h_new[2]);
+            }
         }
         let (c1, c0) = if self.state.step == 0 || self.state.dt_old <= 0.0 {
             (1.0, 0.0)
@@ -542,6 +600,18 @@ impl Flow {
             }
         });
         self.fill_boundaries(t_new);
+        if let (Some(turb), Some(ts)) = (self.turbulence.as_mut(), self.state.turbulence.as_mut()) {
+            turb.step(
+                &self.grid,
+                &self.bc,
+                &self.blocked,
+                self.fluid.viscosity,
+                &self.state.u,
+                t_new,
+                dt,
+                ts,
+            );
+        }
         self.h_new = std::mem::replace(&mut self.state.h_old, h_new);
         self.state.dt_old = dt;
         self.state.t = t_new;
@@ -605,7 +675,22 @@ impl Flow {
             (0..dims).map(|a| u[a][c].abs().max(u[a][c - l.s[a]].abs()) / m[a].d[q[a]]).sum::<f64>()
         });
         let h2 = (0..dims).map(|a| 1.0 / (self.grid.axes[a].min_width().powi(2))).sum::<f64>();
-        let diff = 0.9 / (4.0 * self.fluid.viscosity * h2);
+        let mut diff = 0.9 / (4.0 * self.fluid.viscosity * h2);
+        if let Some(t) = &self.turbulence {
+            // The largest ν_eff Σ 1/Δx² over the cells (ghosts included: they hold the wall viscosity).
+            let nu_rate = max_interior(&l, |c| {
+                let q = l.coords(c);
+                let inv: f64 = (0..dims).map(|a| 1.0 / m[a].d[q[a]].powi(2)).sum();
+                let mut v = t.nu_eff[c];
+                for a in 0..dims {
+                    v = v
+                        .max(0.5 * (t.nu_eff[c] + t.nu_eff[c + l.s[a]]))
+                        .max(0.5 * (t.nu_eff[c] + t.nu_eff[c - l.s[a]]));
+                }
+                v * inv
+            });
+            diff = diff.min(0.9 / (4.0 * nu_rate));
+        }
         let conv = if rate > 0.0 { courant / rate } else { f64::INFINITY };
         dt_max.min(diff).min(conv)
     }
@@ -694,7 +779,15 @@ impl Flow {
                 state.p.len()
             )));
         }
+        if self.turbulence.is_some() != state.turbulence.is_some() {
+            return Err(FlowError::Setup(
+                "the checkpoint was written with a different turbulence model than this flow uses".into(),
+            ));
+        }
         self.state = state;
+        if let (Some(t), Some(ts)) = (self.turbulence.as_mut(), self.state.turbulence.as_ref()) {
+            t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, ts);
+        }
         Ok(())
     }
 }
