@@ -43,16 +43,53 @@ pub fn cell_fields(flow: &Flow) -> CellFields {
     out
 }
 
-/// The flow as a `.vtr` builder with cell arrays `velocity_m_s`, `pressure_Pa` and `solid`; more arrays
-/// (turbulence, sources) can be chained by the caller. Coordinates are the grid's faces; an axisymmetric
+/// The flow as a `.vtr` builder with cell arrays `velocity_m_s`, `pressure_Pa` and `solid`, and
+/// `k_m2_s2`, `epsilon_m2_s3`, `nu_t_m2_s` when the k–ε model runs; more arrays can be chained by the
+/// caller. Coordinates are the grid's faces; an axisymmetric
 /// grid is written as its (r, z) plane with the one-radian third axis as given.
 pub fn to_vtr(flow: &Flow) -> std::io::Result<Vtr> {
     let f = cell_fields(flow);
     let ax = &flow.grid.axes;
-    Ok(Vtr::new(ax[0].faces(), ax[1].faces(), ax[2].faces())?
+    let mut v = Vtr::new(ax[0].faces(), ax[1].faces(), ax[2].faces())?
         .cell_vector("velocity_m_s", &f.velocity)
         .cell_scalar("pressure_Pa", &f.pressure)
-        .cell_int("solid", &f.solid))
+        .cell_int("solid", &f.solid);
+    if let (Some(ts), Some(t)) = (&flow.state.turbulence, &flow.turbulence) {
+        let l = flow.grid.layout;
+        let cells = |val: &dyn Fn(usize) -> f64| -> Vec<f64> {
+            let mut out = Vec::with_capacity(l.cells());
+            for k in 0..l.n[2] {
+                for j in 0..l.n[1] {
+                    for i in 0..l.n[0] {
+                        let c = l.cell(i, j, k);
+                        out.push(if flow.blocked[c] { 0.0 } else { val(c) });
+                    }
+                }
+            }
+            out
+        };
+        let nu = flow.fluid.viscosity;
+        v = v
+            .cell_scalar("k_m2_s2", &cells(&|c| ts.k[c]))
+            .cell_scalar("epsilon_m2_s3", &cells(&|c| ts.eps[c]))
+            .cell_scalar("nu_t_m2_s", &cells(&|c| t.nu_eff[c] - nu));
+    }
+    Ok(v)
+}
+
+/// k \[m²/s²\] and ε \[m²/s³\] of the cell holding `x`, when a turbulence model runs; `None` outside the
+/// grid, in a solid or for laminar flows.
+pub fn turbulence_at(flow: &Flow, x: [f64; 3]) -> Option<(f64, f64)> {
+    let ts = flow.state.turbulence.as_ref()?;
+    let g = &flow.grid;
+    for a in 0..3 {
+        if !(x[a] >= g.axes[a].lo() && x[a] <= g.axes[a].hi()) {
+            return None;
+        }
+    }
+    let q = [0, 1, 2].map(|a| g.axes[a].locate(x[a]));
+    let c = g.layout.cell(q[0], q[1], q[2]);
+    (!flow.blocked[c]).then(|| (ts.k[c], ts.eps[c]))
 }
 
 /// A planar cut of the grid normal to axis `normal` through the cell layer holding coordinate `at`:

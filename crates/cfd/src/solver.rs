@@ -277,12 +277,15 @@ impl Flow {
     /// Bytes a flow on a grid of `n` cells per axis will hold, computed before allocating anything: per
     /// padded cell the velocity (3), pressure, the Adams–Bashforth history (3 + 3), φ and the right-hand
     /// side, the CG vectors (4) and the body force (3, when `with_force`) as f64, three node-kind bytes and
-    /// the blocked flag; plus [`Multigrid::F64_PER_CELL`] values per padded cell of every multigrid level.
+    /// the blocked flag; with `with_turbulence` the k–ε arrays (k, ε, ν_eff, two work arrays and the two
+    /// wall-function sums as f64, a wall count byte); plus [`Multigrid::F64_PER_CELL`] values per padded
+    /// cell of every multigrid level.
     /// Small per-boundary lists and the dense coarsest factor (≤ 64² values) are left out; the estimate is
     /// within a few per cent of [`Flow::heap_bytes`] (tested).
-    pub fn memory_estimate(n: [usize; 3], with_force: bool) -> u64 {
+    pub fn memory_estimate(n: [usize; 3], with_force: bool, with_turbulence: bool) -> u64 {
         let fine = crate::grid::Layout::new(n).len() as u64;
-        let per_cell = 8 * (16 + if with_force { 3 } else { 0 }) + 4;
+        let per_cell =
+            8 * (16 + if with_force { 3 } else { 0 }) + 4 + if with_turbulence { 8 * 7 + 1 } else { 0 };
         let levels: u64 = Multigrid::level_layouts(n).iter().map(|l| l.len() as u64).sum();
         fine * per_cell + levels * 8 * Multigrid::F64_PER_CELL as u64
     }
@@ -294,6 +297,10 @@ impl Flow {
         let mut n = f64s(&st.u) + st.p.capacity() + f64s(&st.h_old) + f64s(&self.h_new);
         n += self.phi.capacity() + self.rhs.capacity();
         n += self.force.as_ref().map_or(0, f64s);
+        if let Some(t) = &self.state.turbulence {
+            n += t.k.capacity() + t.eps.capacity();
+        }
+        let turb = self.turbulence.as_ref().map_or(0, |t| t.heap_bytes());
         let bytes = self.kind.iter().map(Vec::capacity).sum::<usize>() + self.blocked.capacity();
         let lists: usize = (0..3)
             .map(|a| {
@@ -301,7 +308,7 @@ impl Flow {
                     + self.solid_nodes[a].iter().map(|(_, v)| 32 + 8 * v.capacity()).sum::<usize>()
             })
             .sum();
-        (8 * n + bytes + lists) as u64 + self.pcg.heap_bytes()
+        (8 * n + bytes + lists) as u64 + self.pcg.heap_bytes() + turb
     }
 
     /// Switches on the standard k–ε model with wall functions ([`crate::turbulence`]), starting from the
@@ -848,7 +855,8 @@ mod tests {
                     .unwrap();
             let l = f.grid.layout.len();
             f.force = Some([vec![0.0; l], vec![0.0; l], vec![0.0; l]]);
-            let (est, real) = (Flow::memory_estimate(n, true) as f64, f.heap_bytes() as f64);
+            f.enable_k_epsilon(crate::turbulence::KEpsilon::standard(0.05, 0.1));
+            let (est, real) = (Flow::memory_estimate(n, true, true) as f64, f.heap_bytes() as f64);
             assert!((est / real - 1.0).abs() < 0.05, "{n:?}: estimate {est} B, allocated {real} B");
         }
     }

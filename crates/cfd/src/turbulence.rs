@@ -178,6 +178,16 @@ impl Turbulence {
         }
     }
 
+    /// Bytes held on the heap (ν_eff, work arrays, wall lists).
+    pub fn heap_bytes(&self) -> u64 {
+        let f = self.nu_eff.capacity()
+            + self.k_new.capacity()
+            + self.eps_new.capacity()
+            + self.wall_p.capacity()
+            + self.wall_e.capacity();
+        (8 * f + self.wall_n.capacity() + 24 * self.walls.capacity()) as u64
+    }
+
     /// Initial state: the inlet values of the fastest inlet everywhere (or a small k at rest).
     pub fn initial_state(&self, grid: &Grid, bc: &[Boundary; 6]) -> TurbState {
         let speed = bc

@@ -83,6 +83,34 @@ fn the_cavity_example_runs_and_a_resumed_run_writes_the_same_files() {
     }
 }
 
+#[test]
+fn the_turbulent_pipe_example_runs_and_writes_k_and_epsilon() {
+    let text = include_str!("../../../examples/flow_pipe_k_epsilon.toml")
+        .replace(
+            "y = { min_m = 0.0, max_m = 5.0, cells = 100 }",
+            "y = { min_m = 0.0, max_m = 1.0, cells = 20 }",
+        )
+        .replace("end_time_s = 2.0", "end_time_s = 0.1")
+        .replace("at_m = [0.0, 3.0, 0.5]", "at_m = [0.0, 0.6, 0.5]")
+        .replace("at_m = [0.0, 4.0, 0.5]", "at_m = [0.0, 0.8, 0.5]");
+    assert!(text.contains("cells = 20") && text.contains("end_time_s = 0.1"));
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = load(tmp.path(), &text).unwrap();
+    let out = tmp.path().join("out");
+    let s = run(&sc, &out, &Unattended, false).unwrap();
+    let scalar = |n: &str| s.scalars.iter().find(|(k, _)| k == n).map(|(_, v)| *v).unwrap();
+    // The pressure falls along the pipe and the core speeds up as the wall layers grow.
+    assert!(scalar("probe_z30D_p_Pa") > scalar("probe_z40D_p_Pa"));
+    assert!(scalar("probe_z40D_uy_m_s") > 10.0, "{}", scalar("probe_z40D_uy_m_s"));
+    assert!(scalar("kinetic_energy_J_per_rad") > 0.0);
+    let last = std::fs::read_dir(out.join("fields")).unwrap().map(|e| e.unwrap().path()).max().unwrap();
+    let vtr = std::fs::read_to_string(last).unwrap();
+    for name in ["k_m2_s2", "epsilon_m2_s3", "nu_t_m2_s"] {
+        assert!(vtr.contains(&format!("Name=\"{name}\"")), "{name} missing");
+    }
+    assert!(out.join("speed.png").is_file());
+}
+
 /// The message of the first load error of `text`.
 fn load_error(text: &str) -> String {
     let tmp = tempfile::tempdir().unwrap();

@@ -22,6 +22,8 @@ pub struct FlowConfig {
     #[serde(default)]
     pub solids: Vec<Solid>,
     #[serde(default)]
+    pub turbulence: TurbulenceSpec,
+    #[serde(default)]
     pub numerics: NumericsSpec,
     pub time: TimeSpec,
     #[serde(default)]
@@ -130,12 +132,13 @@ impl GridSpec {
         [self.x.cells, self.y.cells, self.z_axis().cells]
     }
 
-    /// Bytes the run will need: the solver's fields ([`Flow::memory_estimate`]) plus the output buffers
+    /// Bytes the run will need: the solver's fields with the turbulence arrays ([`Flow::memory_estimate`])
+    /// plus the output buffers
     /// of one snapshot (about 150 B per cell: cell fields, their copy in the writer and the base64 text).
     pub fn memory_estimate(&self) -> u64 {
         let n = self.cells();
         let cells = n.iter().map(|&v| v as u64).product::<u64>();
-        Flow::memory_estimate(n, false).saturating_add(cells.saturating_mul(150))
+        Flow::memory_estimate(n, false, true).saturating_add(cells.saturating_mul(150))
     }
 }
 
@@ -243,6 +246,36 @@ impl Validate for BoundariesSpec {
     fn validate(&self, c: &mut Checker) {
         for (name, b) in spatter_cfd::bc::SIDES.iter().zip(self.sides().iter()) {
             c.item(name, b);
+        }
+    }
+}
+
+/// The turbulence model (default laminar).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TurbulenceSpec {
+    /// No model: the molecular viscosity only.
+    #[default]
+    Laminar,
+    /// Standard k–ε with log-law wall functions on the no-slip sides (`docs/cfd.md` §2).
+    KEpsilon {
+        /// Turbulence intensity of the inlets \[-\].
+        #[serde(default = "inlet_intensity")]
+        inlet_intensity: f64,
+        /// Turbulence length scale of the inlets \[m\] (about 0.07 D for a pipe of diameter D).
+        inlet_length_scale_m: f64,
+    },
+}
+
+fn inlet_intensity() -> f64 {
+    0.05
+}
+
+impl Validate for TurbulenceSpec {
+    fn validate(&self, c: &mut Checker) {
+        if let TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = self {
+            c.in_range("inlet_intensity", *inlet_intensity, 0.0, false, 1.0, true);
+            c.positive("inlet_length_scale_m", *inlet_length_scale_m);
         }
     }
 }
@@ -437,6 +470,7 @@ impl Validate for FlowConfig {
         for (i, s) in self.solids.iter().enumerate() {
             c.element("solids", i, |c| s.validate(c));
         }
+        c.item("turbulence", &self.turbulence);
         c.item("numerics", &self.numerics);
         c.item("time", &self.time);
         c.item("output", &self.output);

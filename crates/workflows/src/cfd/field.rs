@@ -10,8 +10,8 @@
 //! a central difference over half the local cell width (column j = ∂u/∂x_j, as the trait asks). An
 //! axisymmetric (r, z) solution is swept around its axis: a point x is at radius
 //! r = |(x − o) − ((x − o)·a) a| and axial position (x − o)·a from the origin o along the unit axis a, and
-//! u = u_r e_r + u_z a (no swirl). k and ε are not solved yet (laminar): [`FlowField::has_turbulence`]
-//! is false.
+//! u = u_r e_r + u_z a (no swirl). With the k–ε model, k and ε are those of the cell holding the point
+//! (they drive the tracker's random-walk dispersion); laminar flows report none.
 
 use spatter_cfd::{Flow, Mode};
 use spatter_core::{Aabb, Vec3};
@@ -95,6 +95,13 @@ impl FlowField for SolvedField<'_> {
     fn sample(&self, x: Vec3, _t: f64, _hint: &mut u32, want_grad: bool) -> Option<Sample> {
         let u = self.velocity_from(x)?;
         let mut s = Sample { u, ..Sample::default() };
+        if self.flow.state.turbulence.is_some() {
+            let (q, _) = self.to_grid(x);
+            if let Some((k, eps)) = spatter_cfd::output::turbulence_at(self.flow, q) {
+                s.k = k;
+                s.eps = eps;
+            }
+        }
         if want_grad {
             // Near the edge of the grid a one-sided point may fall outside: use the value at x there.
             s.grad = fd_gradient(|p| self.velocity_from(p).unwrap_or(u), x, self.h);
@@ -133,7 +140,7 @@ impl FlowField for SolvedField<'_> {
     }
 
     fn has_turbulence(&self) -> bool {
-        false
+        self.flow.state.turbulence.is_some()
     }
 }
 

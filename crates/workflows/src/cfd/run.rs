@@ -71,7 +71,15 @@ pub fn build(cfg: &FlowConfig) -> Result<Flow, FlowRunError> {
         max_courant: n.max_courant,
     };
     let fluid = Fluid { density: cfg.fluid.density_kg_m3, viscosity: cfg.fluid.kinematic_viscosity_m2_s };
-    Ok(Flow::new(grid, fluid, cfg.boundaries.sides(), blocked, numerics)?)
+    let mut flow = Flow::new(grid, fluid, cfg.boundaries.sides(), blocked, numerics)?;
+    if let super::config::TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = cfg.turbulence
+    {
+        flow.enable_k_epsilon(spatter_cfd::turbulence::KEpsilon::standard(
+            inlet_intensity,
+            inlet_length_scale_m,
+        ));
+    }
+    Ok(flow)
 }
 
 /// Everything a resumed run needs besides the configuration.
