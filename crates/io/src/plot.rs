@@ -379,8 +379,9 @@ pub struct FieldMap<'a> {
     pub colorbar_label: &'a str,
 }
 
-/// Renders a [`FieldMap`] to scale (equal lengths on both axes) with axes, ticks and a viridis colour bar
-/// spanning the finite values.
+/// Renders a [`FieldMap`] to scale (equal lengths on both axes; a side shorter than 300 px is stretched
+/// to 300 px) with axes, ticks, a title across the picture and a viridis colour bar spanning the finite
+/// values.
 pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
     let (nx, ny) = (map.x_faces.len().saturating_sub(1), map.y_faces.len().saturating_sub(1));
     if nx == 0 || ny == 0 || map.values.len() != nx * ny {
@@ -402,20 +403,22 @@ pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
     } else {
         (vmin - 0.5, vmin + 0.5)
     };
-    // Plot area to scale within 760 × 640 px (at least 160 px on the short side).
+    // Plot area to scale within 760 × 640 px; a side that would be shorter than 300 px is stretched to
+    // 300 px (long thin domains such as pipes), which the axis ticks make plain.
     let scale = (760.0 / (x1 - x0)).min(640.0 / (y1 - y0));
-    let pw = ((x1 - x0) * scale).round().max(160.0) as u32;
-    let ph = ((y1 - y0) * scale).round().max(160.0) as u32;
+    let pw = ((x1 - x0) * scale).round().max(300.0) as u32;
+    let ph = ((y1 - y0) * scale).round().max(300.0) as u32;
     let (left_axis, bottom_axis, margin, caption) = (78u32, 48u32, 14u32, 40u32);
     let chart_w = pw + left_axis + 2 * margin;
     let h = (ph + bottom_axis + 2 * margin + caption).max(600);
-    let w = chart_w + 170;
+    // The title spans the whole picture; it sets the smallest width (about 11 px per character).
+    let w = (chart_w + 170).max(40 + 11 * map.title.chars().count() as u32);
     let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| err(path, x))?;
-    let (left, right) = root.split_horizontally(chart_w);
     let e = |x: DrawingAreaErrorKind<_>| err(path, x);
+    let body = root.titled(map.title, ("sans-serif", 22)).map_err(e)?;
+    let (left, right) = body.split_horizontally(chart_w);
     let mut chart = ChartBuilder::on(&left)
-        .caption(map.title, ("sans-serif", 22))
         .margin(margin)
         .x_label_area_size(bottom_axis)
         .y_label_area_size(left_axis)
@@ -453,8 +456,8 @@ pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
             })
         }))
         .map_err(e)?;
-    let top = 80;
-    let bottom = (h as i32 - 80).min(top + 440);
+    let top = 60;
+    let bottom = (h as i32 - 110).min(top + 440);
     colour_bar(&right, 30, (top, bottom), (vmin, vmax), map.colorbar_label, 15).map_err(e)?;
     root.present().map_err(e)
 }
@@ -669,8 +672,15 @@ mod tests {
         };
         let p = dir.path().join("f.png");
         field_map_png(&p, &map).unwrap();
-        // 4 m × 1 m: 760 × 190 px plot, plus axes, margins and the colour-bar column.
+        // 4 m × 1 m: 760 × 190 px plot (stretched to 300 px high), plus axes, margins and the colour bar.
         assert_eq!(png_size(&p), (760 + 78 + 28 + 170, 600));
+        // A long title widens the picture instead of being cut.
+        let long = "a title much longer than the plot is wide, as a pipe picture has it: speed on the cut";
+        let thin_x = [0.0, 0.05];
+        let thin_y = [0.0, 2.5, 5.0];
+        let thin = FieldMap { x_faces: &thin_x, y_faces: &thin_y, values: &[1.0, 2.0], title: long, ..map };
+        field_map_png(&p, &thin).unwrap();
+        assert_eq!(png_size(&p).0, 40 + 11 * long.chars().count() as u32);
         let short = FieldMap { values: &[1.0; 5], ..map };
         assert!(field_map_png(&p, &short).unwrap_err().to_string().contains("5 values for a 3 × 2 grid"));
     }
