@@ -1,10 +1,10 @@
 //! The scenario file of kind `sph`: every key, its unit and default (documented in `docs/sph.md`).
 
-use crate::boundary::Slip;
-use crate::kernel::KernelKind;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::Vec3;
+use spatter_sph::boundary::Slip;
+use spatter_sph::kernel::KernelKind;
 use std::path::PathBuf;
 
 fn d_dimensions() -> u8 {

@@ -3,7 +3,7 @@
 use spatter_core::check::Checker;
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
 use spatter_io::run::{RunContext, RunDir};
-use spatter_sph::scene::{run, SphConfig};
+use spatter_workflows::sph_scene::{run, SphConfig};
 use std::path::Path;
 
 /// A small 2D dam break with a probe, a wall probe and height sensors.

@@ -3,8 +3,8 @@
 //! `cargo run --release -p spatter-dem --example dem_scene -- examples/dem_hopper.toml runs/hopper [--resume]`
 
 use spatter_core::control::RunControl;
-use spatter_dem::SceneConfig;
 use spatter_io::run::{RunContext, RunDir};
+use spatter_workflows::dem_scene::SceneConfig;
 use std::path::Path;
 
 struct Progress;
@@ -35,7 +35,7 @@ fn main() {
     let dir = RunDir::create(Path::new(&args[2])).expect("output folder");
     let resume = args.iter().any(|a| a == "--resume");
     let t = std::time::Instant::now();
-    match spatter_dem::run(&cfg, &RunContext { dir: &dir, control: &Progress, resume }) {
+    match spatter_workflows::dem_scene::run(&cfg, &RunContext { dir: &dir, control: &Progress, resume }) {
         Ok(s) => {
             for l in s.headline {
                 println!("{l}");

@@ -1,14 +1,14 @@
 //! The DEM scene configuration (`kind = "dem"` scenario files). Every key is documented in `docs/dem.md`.
 
-use crate::adhesion::{AdhesiveCoulomb, BreakCriterion, JkrDamping};
-use crate::contact::RestitutionCalibration;
-use crate::insertion::Lattice;
-use crate::sim::Integrator;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::distribution::SizeDistribution;
 use spatter_core::material::Material;
 use spatter_core::Vec3;
+use spatter_dem::adhesion::{AdhesiveCoulomb, BreakCriterion, JkrDamping};
+use spatter_dem::contact::RestitutionCalibration;
+use spatter_dem::insertion::Lattice;
+use spatter_dem::sim::Integrator;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -82,7 +82,7 @@ pub struct ContactConfig {
     pub hooke_characteristic_speed_m_s: Option<f64>,
     /// `mindlin` (default, k_t = 8G*a, F = k_t ξ), `mindlin_rescale`, `mindlin_force`,
     /// `mindlin_rescale_force` (how the Mindlin history follows the contact radius, see
-    /// [`crate::contact::MindlinHistory`]) or `linear` (k_t = ratio × k_n).
+    /// [`spatter_dem::contact::MindlinHistory`]) or `linear` (k_t = ratio × k_n).
     #[serde(default)]
     pub tangential: TangentialKind,
     /// k_t / k_n of the linear tangential spring (default 2/7).
@@ -90,7 +90,7 @@ pub struct ContactConfig {
     pub linear_stiffness_ratio: f64,
     /// `none` (default), `constant_torque` or `viscous`.
     #[serde(default)]
-    pub rolling: crate::contact::AnyRolling,
+    pub rolling: spatter_dem::contact::AnyRolling,
     /// Damping may not make the normal force tensile (default true).
     #[serde(default = "yes")]
     pub tensile_clamp: bool,
@@ -110,9 +110,9 @@ pub struct ContactConfig {
     #[serde(default)]
     pub adhesive_coulomb: AdhesiveCoulomb,
     /// Hooke and Hertz: the normal force that caps friction, `total` (after damping, default) or
-    /// `elastic` ([`crate::contact::CoulombLoad`]).
+    /// `elastic` ([`spatter_dem::contact::CoulombLoad`]).
     #[serde(default)]
-    pub coulomb_load: crate::contact::CoulombLoad,
+    pub coulomb_load: spatter_dem::contact::CoulombLoad,
 }
 
 fn default_linear_ratio() -> f64 {
@@ -163,8 +163,8 @@ pub enum TangentialKind {
 
 impl TangentialKind {
     /// The Mindlin history rule of a Mindlin kind (`None` for `linear`).
-    pub fn mindlin_history(self) -> Option<crate::contact::MindlinHistory> {
-        use crate::contact::MindlinHistory as H;
+    pub fn mindlin_history(self) -> Option<spatter_dem::contact::MindlinHistory> {
+        use spatter_dem::contact::MindlinHistory as H;
         match self {
             TangentialKind::Mindlin => Some(H::Displacement),
             TangentialKind::MindlinRescale => Some(H::DisplacementRescaled),
@@ -209,11 +209,11 @@ pub struct EngineConfig {
     /// also holds the integrator's O(Δt²) energy error) or `"per_contact"` (every contact books its
     /// dashpot, slip and rolling work in every step; about 15 % slower).
     #[serde(default = "residual")]
-    pub energy_method: crate::sim::EnergyMethod,
+    pub energy_method: spatter_dem::sim::EnergyMethod,
 }
 
-fn residual() -> crate::sim::EnergyMethod {
-    crate::sim::EnergyMethod::Residual
+fn residual() -> spatter_dem::sim::EnergyMethod {
+    spatter_dem::sim::EnergyMethod::Residual
 }
 
 fn default_overlap_fraction() -> f64 {
@@ -264,7 +264,7 @@ pub struct PairValues {
     pub yield_stress_pa: Option<f64>,
     /// `full` (default) or `power_law` form of Thornton's e(V).
     #[serde(default)]
-    pub thornton_form: crate::restitution_models::ThorntonForm,
+    pub thornton_form: spatter_dem::restitution_models::ThorntonForm,
 }
 
 /// How a pair's coefficient of restitution is given.
@@ -318,7 +318,7 @@ pub struct PairOverride {
     #[serde(default)]
     pub yield_stress_pa: Option<f64>,
     #[serde(default)]
-    pub thornton_form: Option<crate::restitution_models::ThorntonForm>,
+    pub thornton_form: Option<spatter_dem::restitution_models::ThorntonForm>,
 }
 
 /// A wall.
@@ -631,7 +631,7 @@ impl Validate for SceneConfig {
                 );
             }
             if matches!(k.normal, NormalKind::Jkr | NormalKind::Dmt | NormalKind::Sjkr)
-                && k.coulomb_load != crate::contact::CoulombLoad::Total
+                && k.coulomb_load != spatter_dem::contact::CoulombLoad::Total
             {
                 c.fail(
                     "coulomb_load",

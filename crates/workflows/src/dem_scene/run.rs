@@ -2,21 +2,21 @@
 
 use super::config::{NormalKind, SceneConfig, TangentialKind};
 use super::setup;
-use crate::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
-use crate::contact::{
-    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
-    RestitutionDamping,
-};
-use crate::error::DemError;
-use crate::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
-use crate::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
-use crate::restitution_models::{RestitutionModel, SpeedDependentDamping};
-use crate::sim::{SimState, Simulation};
-use crate::timestep;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
 use spatter_core::control::Finished;
 use spatter_core::Aabb;
+use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
+use spatter_dem::contact::{
+    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
+    RestitutionDamping,
+};
+use spatter_dem::error::DemError;
+use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
+use spatter_dem::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
+use spatter_dem::restitution_models::{RestitutionModel, SpeedDependentDamping};
+use spatter_dem::sim::{SimState, Simulation};
+use spatter_dem::timestep;
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
 use spatter_io::run::{RunContext, RunSummary};
@@ -205,7 +205,7 @@ fn run_with<L: ContactLaw>(
     ctx: &RunContext,
 ) -> Result<RunSummary, DemError> {
     let e = &cfg.engine;
-    let settings = crate::sim::Settings {
+    let settings = spatter_dem::sim::Settings {
         integrator: e.integrator,
         skin: e.skin_m,
         verlet_list: e.verlet_list,
@@ -216,7 +216,8 @@ fn run_with<L: ContactLaw>(
         },
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
-    sim.energy_method = if e.track_energy { e.energy_method } else { crate::sim::EnergyMethod::PerContact };
+    sim.energy_method =
+        if e.track_energy { e.energy_method } else { spatter_dem::sim::EnergyMethod::PerContact };
     sim.gravity = cfg.gravity_m_s2;
     for w in built.walls {
         sim.add_wall(w);
@@ -358,7 +359,7 @@ fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &R
         );
     }
     for (x, r) in placed {
-        let mut np = crate::particles::NewParticle::at(x, r, inj.material);
+        let mut np = spatter_dem::particles::NewParticle::at(x, r, inj.material);
         np.vel = inj.velocity;
         sim.add_particle(np);
     }
@@ -392,7 +393,7 @@ fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> 
             }
         }
         for w in &sim.walls {
-            if let crate::walls::WallShape::Mesh(m) = &w.shape {
+            if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
                 b = b.union(m.mesh.bounds());
             }
         }

@@ -2,9 +2,6 @@
 
 use super::build::{build, BuildInfo};
 use super::config::SphConfig;
-use super::wetting::{default_view, particle_map, wet_area, wetting_map};
-use crate::error::SphError;
-use crate::sim::Simulation;
 use serde::{Deserialize, Serialize};
 use spatter_core::control::Finished;
 use spatter_core::Vec3;
@@ -12,6 +9,9 @@ use spatter_io::csv::{write_table, CsvSeries};
 use spatter_io::pvd::PvdSeries;
 use spatter_io::run::{RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
+use spatter_sph::error::SphError;
+use spatter_sph::sim::Simulation;
+use spatter_sph::wetting::{default_view, particle_map, wet_area, wetting_map};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

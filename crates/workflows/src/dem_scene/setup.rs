@@ -2,23 +2,23 @@
 //! injectors.
 
 use super::config::*;
-use crate::contact::{PairProps, PairTable};
-use crate::error::DemError;
-use crate::insertion::{
-    lattice_fill, random_fill, FillTarget, InjectionRate, Injector, InjectorState, OverlapIndex, Region,
-    WallClearance,
-};
-use crate::particles::NewParticle;
-use crate::restitution_models::{RestitutionModel, YieldGeometry};
-use crate::walls::{Cylinder, MeshWall, Plane, Rectangle, Wall, WallShape};
 use spatter_core::distribution::SizeDistribution;
 use spatter_core::material::Material;
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::rng::{seeded, Rng};
 use spatter_core::{Aabb, Vec3};
+use spatter_dem::contact::{PairProps, PairTable};
+use spatter_dem::error::DemError;
+use spatter_dem::insertion::{
+    lattice_fill, random_fill, FillTarget, InjectionRate, Injector, InjectorState, OverlapIndex, Region,
+    WallClearance,
+};
+use spatter_dem::particles::NewParticle;
+use spatter_dem::restitution_models::{RestitutionModel, YieldGeometry};
+use spatter_dem::walls::{Cylinder, MeshWall, Plane, Rectangle, Wall, WallShape};
 
-pub use crate::insertion::max_diameter;
+pub use spatter_dem::insertion::max_diameter;
 
 /// Standard normal quantile of 10⁻³ (Abramowitz & Stegun 1964, table 26.1: z = −3.090 23).
 const Z_1E3: f64 = -3.090_232_3;

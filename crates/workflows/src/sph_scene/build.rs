@@ -1,13 +1,13 @@
 //! Turns a validated [`SphConfig`] into a ready [`Simulation`].
 
 use super::config::{axis_index, face_index, FillType, MotionType, SphConfig, WallType};
-use crate::error::SphError;
-use crate::kernel::Dim;
-use crate::params::{DragParams, SphParams};
-use crate::sim::{Simulation, WallOptions};
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::{Aabb, Vec3};
+use spatter_sph::error::SphError;
+use spatter_sph::kernel::Dim;
+use spatter_sph::params::{DragParams, SphParams};
+use spatter_sph::sim::{Simulation, WallOptions};
 use std::path::Path;
 
 /// Numbers fixed while building, reported in the log.

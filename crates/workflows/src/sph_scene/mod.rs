@@ -4,7 +4,6 @@
 mod build;
 pub mod config;
 mod run;
-pub mod wetting;
 
 pub use build::{build, BuildInfo};
 pub use config::SphConfig;

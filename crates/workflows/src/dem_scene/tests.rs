@@ -174,7 +174,7 @@ fn shipped_examples_are_valid() {
 
 #[test]
 fn tangential_history_rule_is_selectable_from_the_scene() {
-    use crate::contact::MindlinHistory as H;
+    use spatter_dem::contact::MindlinHistory as H;
     for (key, rule) in [
         ("mindlin", Some(H::Displacement)),
         ("mindlin_rescale", Some(H::DisplacementRescaled)),
@@ -214,7 +214,7 @@ fn assert_pour_differs(what: &str, settings: [&dyn Fn(&mut SceneConfig); 2]) {
 
 #[test]
 fn coulomb_load_is_selectable_from_the_scene_and_refused_for_adhesive_laws() {
-    use crate::contact::CoulombLoad;
+    use spatter_dem::contact::CoulombLoad;
     for (key, load) in [("total", CoulombLoad::Total), ("elastic", CoulombLoad::Elastic)] {
         let c: ContactConfig = toml::from_str(&format!("coulomb_load = \"{key}\"")).unwrap();
         assert_eq!(c.coulomb_load, load, "{key}");
@@ -458,7 +458,7 @@ shape = { type = "rectangle", center_m = [0.05, 0, 0], half_u_m = [0.03, 0, 0], 
     let m = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     let p_y: f64 = 2.5e6;
     let v_y = 3.194 * (p_y.powi(5) * r.powi(3) / (e_star.powi(4) * m)).sqrt();
-    let e_a = crate::restitution_models::thornton_full(v0, v_y);
+    let e_a = spatter_dem::restitution_models::thornton_full(v0, v_y);
     assert!((v_y - 0.1022).abs() < 1e-3 && (e_a - 0.5).abs() > 0.05, "V_y = {v_y}, e = {e_a}");
     assert!((e[0] - e_a).abs() < 2e-4, "Thornton pair: e = {} vs {e_a}", e[0]);
     assert!((e[1] - 0.5).abs() < 2e-4, "constant pair: e = {} vs 0.5", e[1]);
@@ -489,7 +489,7 @@ fn restitution_model_keys_are_checked() {
         "restitution_model = \"thornton\"\nyield_stress_pa = 2e6\nthornton_form = \"power_law\"",
     )
     .unwrap();
-    assert_eq!(v.thornton_form, crate::restitution_models::ThorntonForm::PowerLaw);
+    assert_eq!(v.thornton_form, spatter_dem::restitution_models::ThorntonForm::PowerLaw);
 }
 
 #[test]
