@@ -4,7 +4,8 @@
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
-//! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
+//! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
+//! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
 //! * [`plot`] — PNG/SVG charts and mesh colour maps.
 
 pub mod checkpoint;
@@ -12,6 +13,7 @@ pub mod csv;
 pub mod plot;
 pub mod pvd;
 pub mod run;
+pub mod runlog;
 pub mod vtu;
 
 /// Formats `x` so that it parses back to the same `f64` (shortest round-trip form), in exponent notation

@@ -40,6 +40,11 @@ macro_rules! kinds {
                 match *self { $( Scenario::$variant(ref c) => $run(c, ctx).map_err(|e| Box::new(e) as RunError), )* }
             }
 
+            /// Cuts the scenario down to a smoke test (see [`spatter_io::run::Smoke`]).
+            pub fn smoke(&mut self) {
+                match *self { $( Scenario::$variant(ref mut c) => spatter_io::run::Smoke::smoke(c), )* }
+            }
+
             /// The fully resolved input as TOML (`kind` first, every default filled in).
             pub fn resolved_toml(&self) -> Result<String, String> {
                 match *self { $( Scenario::$variant(ref c) => resolved($name, c), )* }

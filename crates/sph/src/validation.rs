@@ -228,7 +228,7 @@ pub fn hydrostatic_tank(quick: bool) -> Vec<Check> {
         }
     });
     let mut checks = Vec::new();
-    let src = "hydrostatics p = ρ g z (VERIFICATION.md, SPH)";
+    let src = "hydrostatics p = ρ g z";
     for frac in [0.25, 0.5, 0.75] {
         let z = depth * (1.0 - frac);
         let x = Vec3::new(0.5 * width, 0.5 * ly, z);

@@ -35,7 +35,7 @@ fn main() {
     let dir = RunDir::create(Path::new(&args[2])).expect("output folder");
     let resume = args.iter().any(|a| a == "--resume");
     let t = std::time::Instant::now();
-    match spatter_workflows::dem_scene::run(&cfg, &RunContext { dir: &dir, control: &Progress, resume }) {
+    match spatter_workflows::dem_scene::run(&cfg, &RunContext::new(&dir, &Progress, resume)) {
         Ok(s) => {
             for l in s.headline {
                 println!("{l}");

@@ -540,7 +540,7 @@ fn check_region(c: &mut Checker, key: &str, r: &RegionConfig) {
             c.positive("height_m", *height_m);
         }
         RegionConfig::Mesh { file, scale } => {
-            c.file_exists("file", file);
+            c.mesh_file("file", file);
             c.positive("scale", *scale);
         }
     });
@@ -592,11 +592,48 @@ fn check_restitution_model(c: &mut Checker, kind: RestitutionKind, yield_stress:
     }
 }
 
+/// Largest accepted number of time steps (`duration_s / dt_s`).
+pub const MAX_STEPS: f64 = 1e11;
+
+/// Memory per particle of a scene, for the size estimate before a fill \[B\] (state, neighbour list and
+/// contact history of a settled packing, with margin).
+pub const BYTES_PER_PARTICLE: u64 = 1000;
+
 impl Validate for SceneConfig {
     fn validate(&self, c: &mut Checker) {
         c.positive("dt_s", self.dt_s);
         c.positive("duration_s", self.duration_s);
         c.positive("output_interval_s", self.output_interval_s);
+        let steps = self.duration_s / self.dt_s;
+        if steps.is_finite() && steps > MAX_STEPS {
+            c.fail(
+                "dt_s",
+                format!(
+                    "duration_s / dt_s = {} / {} = {steps:.3e} steps is above {MAX_STEPS:e}; a run this long \
+                     never ends — shorten duration_s or lengthen dt_s",
+                    self.duration_s, self.dt_s
+                ),
+            );
+        } else if self.dt_s > self.duration_s {
+            c.fail(
+                "dt_s",
+                format!(
+                    "dt_s = {} is longer than duration_s = {}: the run would take one step and show nothing",
+                    self.dt_s, self.duration_s
+                ),
+            );
+        }
+        for (i, f) in self.fill.iter().enumerate() {
+            if let Some(n) = f.count {
+                c.element("fill", i, |c| {
+                    c.memory_estimate(
+                        "count",
+                        &format!("count = {n} particles × {BYTES_PER_PARTICLE} B"),
+                        n as f64 * BYTES_PER_PARTICLE as f64,
+                    )
+                });
+            }
+        }
         c.finite_vec("gravity_m_s2", self.gravity_m_s2);
         if self.materials.is_empty() {
             c.fail("materials", "at least one material is needed, e.g. [materials.glass]".to_string());
@@ -721,7 +758,7 @@ impl Validate for SceneConfig {
                         }
                     }
                     ShapeConfig::Mesh { file, scale } => {
-                        c.file_exists("file", file);
+                        c.mesh_file("file", file);
                         c.positive("scale", *scale);
                     }
                 });
@@ -734,7 +771,7 @@ impl Validate for SceneConfig {
                         c.finite("angular_speed_rad_s", *angular_speed_rad_s);
                     }
                     MotionConfig::Tabulated { file, reference_point_m } => {
-                        c.file_exists("file", file);
+                        c.motion_table_file("file", file);
                         c.finite_vec("reference_point_m", *reference_point_m);
                     }
                 });
@@ -760,7 +797,7 @@ impl Validate for SceneConfig {
                     FillMethod::Lattice => {
                         if let Some(s) = f.spacing_m {
                             c.positive("spacing_m", s);
-                        } else if super::setup::max_diameter(&f.size).is_none() {
+                        } else if spatter_dem::insertion::max_diameter(&f.size).is_none() {
                             c.fail(
                                 "spacing_m",
                                 "a lattice fill with an unbounded size distribution needs spacing_m"
@@ -795,6 +832,20 @@ impl Validate for SceneConfig {
                 c.positive("interval_s", j.interval_s);
                 c.finite_vec("velocity_m_s", j.velocity_m_s);
             });
+        }
+    }
+}
+
+impl spatter_io::run::Smoke for SceneConfig {
+    /// 40 steps, an output at the start, half-way and the end; fills of a counted size keep at most 200
+    /// particles (lattice and fraction fills keep their region: they are set up, not stepped, in bulk).
+    fn smoke(&mut self) {
+        self.duration_s = self.duration_s.min(40.0 * self.dt_s);
+        self.output_interval_s = self.output_interval_s.min(20.0 * self.dt_s);
+        for f in &mut self.fill {
+            if let Some(n) = &mut f.count {
+                *n = (*n).min(200);
+            }
         }
     }
 }

@@ -239,7 +239,7 @@ fn run_with<L: ContactLaw>(
     let warnings: Vec<String>;
     let mut out;
     if ctx.resume {
-        let ck: Checkpoint<L::State> = spatter_io::checkpoint::load(&dir.checkpoint_path())?;
+        let ck: Checkpoint<L::State> = ctx.load_checkpoint()?;
         if ck.scene_hash != hash {
             return Err(DemError::Resume(format!(
                 "{} was written by a different scene; run without resume to start afresh",
@@ -296,7 +296,8 @@ fn run_with<L: ContactLaw>(
     }
 
     while sim.step_count() < total_steps {
-        if ctx.control.stop_requested() {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
             out.csv.flush().map_err(io(&csv_path))?;
             let ck = Checkpoint {
                 scene_hash: hash,
@@ -306,7 +307,9 @@ fn run_with<L: ContactLaw>(
                 csv_bytes: out.csv.bytes_written(),
                 warnings: warnings.clone(),
             };
-            spatter_io::checkpoint::save(&dir.checkpoint_path(), &ck)?;
+            ctx.save_checkpoint(&ck)?;
+        }
+        if stop {
             let mut s = RunSummary::new(Finished::Interrupted);
             s.headline.push(format!(
                 "stopped at step {} of {total_steps} (t = {:.6} s); checkpoint written, resume to continue",

@@ -98,15 +98,15 @@ fn interrupted_and_resumed_run_equals_uninterrupted_run_bit_for_bit() {
     let tmp = tempfile::tempdir().unwrap();
     let cfg = parse(&pour_toml(&floor_stl(tmp.path())));
     let full = RunDir::create(&tmp.path().join("full")).unwrap();
-    let s = run(&cfg, &RunContext { dir: &full, control: &Unattended, resume: false }).unwrap();
+    let s = run(&cfg, &RunContext::new(&full, &Unattended, false)).unwrap();
     assert_eq!(s.finished, Finished::Completed);
     let part = RunDir::create(&tmp.path().join("part")).unwrap();
     // Stop after 333 polls (one per step), in the middle of an output interval and after injections.
     let stop = StopAfterPolls::new(333);
-    let s = run(&cfg, &RunContext { dir: &part, control: &stop, resume: false }).unwrap();
+    let s = run(&cfg, &RunContext::new(&part, &stop, false)).unwrap();
     assert_eq!(s.finished, Finished::Interrupted);
     assert!(part.checkpoint_path().is_file());
-    let s = run(&cfg, &RunContext { dir: &part, control: &Unattended, resume: true }).unwrap();
+    let s = run(&cfg, &RunContext::new(&part, &Unattended, true)).unwrap();
     assert_eq!(s.finished, Finished::Completed);
     assert!(!part.checkpoint_path().is_file(), "checkpoint removed after completion");
     for rel in [
@@ -205,7 +205,7 @@ fn assert_pour_differs(what: &str, settings: [&dyn Fn(&mut SceneConfig); 2]) {
         let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
         set(&mut cfg);
         let dir = RunDir::create(&tmp.path().join(format!("run{k}"))).unwrap();
-        let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+        let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap();
         assert_eq!(s.finished, Finished::Completed);
         csv.push(std::fs::read_to_string(dir.root().join("energy.csv")).unwrap());
     }
@@ -335,8 +335,7 @@ fn fills_and_injections_cut_by_walls_create_no_overlaps_and_run() {
     assert!(ps.iter().any(|p| p.pos.truncate().length() < 0.01 + 2.0 * p.radius));
     assert!(ps.iter().any(|p| (p.pos.z - 0.125).abs() < 2.0 * p.radius));
     let dir = RunDir::create(&tmp.path().join("run")).unwrap();
-    let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false })
-        .unwrap_or_else(|e| panic!("{e}"));
+    let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.finished, Finished::Completed);
     // 0.05 kg/s for 4 ms: 2e-4 kg, within half a particle (≤ 2.83e-7 kg for 6 mm) of the target.
     let line = s.headline.iter().find(|l| l.starts_with("inject[0]")).expect("injector line");
@@ -443,7 +442,7 @@ shape = { type = "rectangle", center_m = [0.05, 0, 0], half_u_m = [0.03, 0, 0], 
     let cfg = parse(&text);
     Checker::run(&cfg, None).unwrap();
     let dir = RunDir::create(&tmp.path().join("run")).unwrap();
-    let s = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+    let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap();
     assert_eq!(s.finished, Finished::Completed);
     let vtu = spatter_io::vtu::read(&dir.root().join("particles/particles_00001.vtu")).unwrap();
     let (ids, vel) = (&vtu.point_data["id"].1, &vtu.point_data["velocity_m_s"].1);

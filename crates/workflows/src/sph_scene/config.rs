@@ -397,9 +397,75 @@ fn check_box(c: &mut Checker, min: Option<Vec3>, max: Option<Vec3>, what: &str, 
     }
 }
 
+/// Memory per particle for the size estimate \[B\] (fluid state, neighbour lists and wall data measured
+/// at about 300 B, with margin).
+pub const BYTES_PER_PARTICLE: f64 = 400.0;
+
+/// Largest accepted number of time steps, estimated before the run from `end_time_s` and the acoustic
+/// time step (see [`SphConfig::estimated_steps`]).
+pub const MAX_STEPS: f64 = 1e10;
+
+impl SphConfig {
+    /// A lower bound on the number of time steps: `end_time_s` over the acoustic limit
+    /// 0.4 h / c₀ with c₀ = `sound_speed_factor` × the free-fall speed from the top of the highest fill
+    /// (the run's own c₀ is at least this, its step at most this long); `None` without fills.
+    pub fn estimated_steps(&self) -> Option<f64> {
+        let dp = self.fluid.spacing_m;
+        let h = self.fluid.h_over_dp.unwrap_or(if self.fluid.dimensions == 2 { 2.0 } else { 1.5 }) * dp;
+        let top = self.fill.iter().map(|f| (f.max_m.z - f.min_m.z).abs()).fold(0.0, f64::max);
+        let u = self.fluid.max_velocity_m_s.unwrap_or(0.0).max((2.0 * 9.81 * top).sqrt());
+        let c0 = self.fluid.sound_speed_factor * u;
+        (c0 > 0.0 && h > 0.0).then(|| self.output.end_time_s * c0 / (0.4 * h))
+    }
+
+    /// Rough particle count before anything is built: fill boxes over dp^d, plus tank and block walls
+    /// (their surface over dp^(d−1), times the wall layers). Mesh and cylinder walls are not counted.
+    pub fn estimated_particles(&self) -> f64 {
+        let dp = self.fluid.spacing_m;
+        let plane = self.fluid.dimensions == 2;
+        let size = |a: Vec3, b: Vec3| {
+            let e = (b - a).abs();
+            if plane {
+                e.x * e.z / (dp * dp)
+            } else {
+                e.x * e.y * e.z / (dp * dp * dp)
+            }
+        };
+        let surface = |a: Vec3, b: Vec3| {
+            let e = (b - a).abs();
+            if plane {
+                2.0 * (e.x + e.z) / dp
+            } else {
+                2.0 * (e.x * e.y + e.y * e.z + e.x * e.z) / (dp * dp)
+            }
+        };
+        let fluid: f64 = self.fill.iter().map(|f| size(f.min_m, f.max_m)).sum();
+        let walls: f64 = self
+            .walls
+            .iter()
+            .filter(|w| matches!(w.kind, WallType::Tank | WallType::Block))
+            .filter_map(|w| Some(surface(w.min_m?, w.max_m?) * w.layers.unwrap_or(3) as f64))
+            .sum();
+        fluid + walls
+    }
+}
+
 impl Validate for SphConfig {
     fn validate(&self, c: &mut Checker) {
         c.item("fluid", &self.fluid);
+        if self.fluid.spacing_m > 0.0 && self.fluid.spacing_m.is_finite() {
+            let n = self.estimated_particles();
+            c.nested("fluid", |c| {
+                c.memory_estimate(
+                    "spacing_m",
+                    &format!(
+                        "spacing_m = {} m gives about {n:.3e} fluid and wall particles; × {BYTES_PER_PARTICLE} B, that",
+                        self.fluid.spacing_m
+                    ),
+                    n * BYTES_PER_PARTICLE,
+                )
+            });
+        }
         let plane = self.fluid.dimensions == 2;
         c.nested("drag", |c| {
             c.positive("air_density_kg_m3", self.drag.air_density_kg_m3);
@@ -462,7 +528,7 @@ impl Validate for SphConfig {
                     }
                     MotionType::Table => {
                         match &m.file {
-                            Some(f) => c.file_exists("file", f),
+                            Some(f) => c.motion_table_file("file", f),
                             None => {
                                 c.fail("file", "a table motion needs `file` (rows `t vx vy vz wx wy wz`)")
                             }
@@ -504,7 +570,7 @@ impl Validate for SphConfig {
                     }
                     WallType::Mesh => {
                         match &w.file {
-                            Some(f) => c.file_exists("file", f),
+                            Some(f) => c.mesh_file("file", f),
                             None => c.fail("file", "a mesh wall needs `file` (.stl or .obj)"),
                         }
                         c.positive("scale", w.scale);
@@ -539,8 +605,29 @@ impl Validate for SphConfig {
         if self.fill.is_empty() {
             c.fail("fill", "at least one [[fill]] region is needed");
         }
+        // Fluid lives inside the tanks (and the domain): a fill box that misses all of them makes no fluid.
+        let tanks: Vec<(Vec3, Vec3)> = self
+            .walls
+            .iter()
+            .filter(|w| w.kind == WallType::Tank)
+            .filter_map(|w| Some((w.min_m?, w.max_m?)))
+            .chain(self.domain.min_m.zip(self.domain.max_m))
+            .collect();
+        let overlaps = |(a, b): &(Vec3, Vec3), f: &FillConfig| {
+            let axes: &[usize] = if plane { &[0, 2] } else { &[0, 1, 2] };
+            axes.iter().all(|&k| f.min_m[k] < b[k] && f.max_m[k] > a[k])
+        };
         for (i, f) in self.fill.iter().enumerate() {
             c.element("fill", i, |c| {
+                if !tanks.is_empty() && !tanks.iter().any(|t| overlaps(t, f)) {
+                    c.fail(
+                        "min_m",
+                        format!(
+                            "the fill box [{}, {}] lies outside every tank and the domain: it would make no fluid",
+                            f.min_m, f.max_m
+                        ),
+                    );
+                }
                 check_box(c, Some(f.min_m), Some(f.max_m), "fill region", plane);
                 c.finite_vec("velocity_m_s", f.velocity_m_s);
                 if f.kind == FillType::Flood {
@@ -554,6 +641,16 @@ impl Validate for SphConfig {
         c.nested("output", |c| {
             let o = &self.output;
             c.positive("end_time_s", o.end_time_s);
+            if let Some(n) = self.estimated_steps().filter(|n| *n > MAX_STEPS) {
+                c.fail(
+                    "end_time_s",
+                    format!(
+                        "end_time_s = {} s needs at least {n:.3e} time steps at spacing_m = {} m (above \
+                         {MAX_STEPS:e}); a run this long never ends",
+                        o.end_time_s, self.fluid.spacing_m
+                    ),
+                );
+            }
             if let Some(v) = o.vtu_interval_s {
                 c.positive("vtu_interval_s", v);
             }
@@ -653,5 +750,15 @@ impl Validate for FluidConfig {
             c.fail("density_window", format!("density_window = [{lo}, {hi}] must satisfy 0 ≤ lo < 1 < hi"));
         }
         c.in_range("guard_offset", self.guard_offset, 0.0, false, 1.0, true);
+    }
+}
+
+impl spatter_io::run::Smoke for SphConfig {
+    /// 2.5 ms of simulated time (a few tens of steps at the usual spacings), two snapshots, five samples.
+    fn smoke(&mut self) {
+        let end = self.output.end_time_s.min(2.5e-3);
+        self.output.end_time_s = end;
+        self.output.vtu_interval_s = Some(end / 2.0);
+        self.output.sample_interval_s = Some(end / 5.0);
     }
 }

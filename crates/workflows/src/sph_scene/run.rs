@@ -12,7 +12,6 @@ use spatter_io::vtu::Vtu;
 use spatter_sph::error::SphError;
 use spatter_sph::sim::Simulation;
 use spatter_sph::wetting::{default_view, particle_map, wet_area, wetting_map};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -25,7 +24,6 @@ struct SceneState {
     vtu_count: u32,
     next_sample: f64,
     series_bytes: u64,
-    log_bytes: u64,
     /// ∫ volume per height bin dt over the averaging window \[m⁴ or m³ in 2D\], and the time covered.
     height_volume_time: Vec<f64>,
     height_time: f64,
@@ -139,41 +137,6 @@ fn write_walls(path: &Path, sim: &Simulation) -> std::io::Result<()> {
         .write(path)
 }
 
-struct Log {
-    file: std::fs::File,
-    bytes: u64,
-}
-
-impl Log {
-    fn open(path: &Path, keep: Option<u64>) -> std::io::Result<Self> {
-        let file = match keep {
-            None => std::fs::File::create(path)?,
-            Some(n) => {
-                let f = std::fs::OpenOptions::new()
-                    .read(true)
-                    .write(true)
-                    .create(true)
-                    .truncate(false)
-                    .open(path)?;
-                f.set_len(n)?;
-                let mut f = f;
-                use std::io::Seek;
-                f.seek(std::io::SeekFrom::Start(n))?;
-                f
-            }
-        };
-        Ok(Log { file, bytes: keep.unwrap_or(0) })
-    }
-
-    fn line(&mut self, s: &str) -> std::io::Result<()> {
-        tracing::info!("{s}");
-        let l = format!("{s}\n");
-        self.file.write_all(l.as_bytes())?;
-        self.bytes += l.len() as u64;
-        Ok(())
-    }
-}
-
 fn io_at(path: &Path) -> impl Fn(std::io::Error) -> SphError + '_ {
     move |e| SphError::Io(std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }
@@ -191,24 +154,20 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
     let ckpt = dir.checkpoint_path();
     let series_path = dir.path("series.csv");
     let pvd_path = dir.path("particles.pvd");
-    let log_path = dir.path("log.txt");
     let session = Instant::now();
-    let (mut st, mut series, mut pvd, mut log) = if ctx.resume && ckpt.exists() {
-        let mut st: SceneState = spatter_io::checkpoint::load(&ckpt)?;
+    let (mut st, mut series, mut pvd) = if ctx.resume && ckpt.exists() {
+        let mut st: SceneState = ctx.load_checkpoint()?;
         st.sim.refresh();
         let cols = series_columns(cfg, &st.sim);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let series = CsvSeries::resume(&series_path, &cols, st.series_bytes).map_err(io_at(&series_path))?;
         let mut pvd = PvdSeries::load_or_new(&pvd_path).map_err(io_at(&pvd_path))?;
         pvd.truncate_after(st.sim.time).map_err(io_at(&pvd_path))?;
-        let mut log = Log::open(&log_path, Some(st.log_bytes)).map_err(io_at(&log_path))?;
-        log.line(&format!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps))
-            .map_err(io_at(&log_path))?;
-        (st, series, pvd, log)
+        tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
+        (st, series, pvd)
     } else {
-        let mut log = Log::open(&log_path, None).map_err(io_at(&log_path))?;
         let (sim, info) = build(cfg, base)?;
-        log.line(&format!(
+        tracing::info!(
             "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s)",
             cfg.title,
             info.fluid_particles,
@@ -219,8 +178,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             info.sound_speed,
             sim.dt,
             rayon::current_num_threads()
-        ))
-        .map_err(io_at(&log_path))?;
+        );
         let cols = series_columns(cfg, &sim);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let series = CsvSeries::create(&series_path, &cols).map_err(io_at(&series_path))?;
@@ -233,7 +191,6 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             vtu_count: 0,
             next_sample: 0.0,
             series_bytes: 0,
-            log_bytes: 0,
             height_volume_time: vec![0.0; nb],
             height_time: 0.0,
             flux_started: false,
@@ -245,7 +202,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             let p = dir.path("walls.vtu");
             write_walls(&p, &st.sim).map_err(io_at(&p))?;
         }
-        (st, series, pvd, log)
+        (st, series, pvd)
     };
     let end = cfg.output.end_time_s;
     let vtu_dt = cfg.output.vtu_interval();
@@ -272,7 +229,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             }
             st.vtu_count += 1;
             let l = st.sim.last;
-            log.line(&format!(
+            tracing::info!(
                 "t = {:.6} s, step {}, dt = {:.4e} s (acoustic {:.3e}, force {:.3e}, viscous {:.3e}), {} particles, removed {} (domain) + {} (density), max speed {:.4} m/s, density {:.4}–{:.4} ρ0, guard stops {}",
                 st.sim.time,
                 st.sim.steps,
@@ -287,15 +244,13 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
                 l.min_density_ratio,
                 l.max_density_ratio,
                 l.guard_hits
-            ))
-            .map_err(io_at(&log_path))?;
+            );
             if l.max_speed > 0.1 * st.sim.params.sound_speed {
-                log.line(&format!(
-                    "warning: max speed {:.4} m/s exceeds c0/10 = {:.4} m/s; density errors may exceed 1 % — raise fluid.max_velocity_m_s",
+                tracing::warn!(
+                    "max speed {:.4} m/s exceeds c0/10 = {:.4} m/s; density errors may exceed 1 % — raise fluid.max_velocity_m_s",
                     l.max_speed,
                     0.1 * st.sim.params.sound_speed
-                ))
-                .map_err(io_at(&log_path))?;
+                );
             }
             while st.next_vtu <= st.sim.time + 1e-12 * end {
                 st.next_vtu += vtu_dt;
@@ -304,21 +259,27 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
         if st.sim.time >= end - 1e-12 * end {
             break;
         }
-        if ctx.control.stop_requested() {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
             series.flush().map_err(io_at(&series_path))?;
             st.series_bytes = series.bytes_written();
+            // The checkpoint holds the wall time up to now; this session's count goes on from here.
+            let earlier = st.wall_seconds;
             st.wall_seconds += session.elapsed().as_secs_f64();
-            log.line(&format!(
-                "stopped at t = {:.6} s, step {}; checkpoint written",
-                st.sim.time, st.sim.steps
-            ))
-            .map_err(io_at(&log_path))?;
-            st.log_bytes = log.bytes;
-            spatter_io::checkpoint::save(&ckpt, &st)?;
-            let mut s = RunSummary::new(Finished::Interrupted);
-            s.headline.push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
-            s.artifacts.push(("checkpoint".into(), ckpt));
-            return Ok(s);
+            ctx.save_checkpoint(&st)?;
+            if stop {
+                tracing::info!(
+                    "stopped at t = {:.6} s, step {}; checkpoint written",
+                    st.sim.time,
+                    st.sim.steps
+                );
+                let mut s = RunSummary::new(Finished::Interrupted);
+                s.headline
+                    .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
+                s.artifacts.push(("checkpoint".into(), ckpt));
+                return Ok(s);
+            }
+            st.wall_seconds = earlier;
         }
         st.sim.step()?;
         accumulate_height(cfg, &mut st);
@@ -326,7 +287,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
     }
     series.flush().map_err(io_at(&series_path))?;
     let wall = st.wall_seconds + session.elapsed().as_secs_f64();
-    finish(cfg, ctx, st, wall, &mut log, &log_path)
+    finish(cfg, ctx, st, wall)
 }
 
 /// Height bins and plane fluxes over the averaging window.
@@ -359,14 +320,7 @@ fn accumulate_height(cfg: &SphConfig, st: &mut SceneState) {
     }
 }
 
-fn finish(
-    cfg: &SphConfig,
-    ctx: &RunContext,
-    st: SceneState,
-    wall: f64,
-    log: &mut Log,
-    log_path: &Path,
-) -> Result<RunSummary, SphError> {
+fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Result<RunSummary, SphError> {
     let dir = ctx.dir;
     let mut sim = st.sim;
     let mut summary = RunSummary::new(Finished::Completed);
@@ -423,6 +377,7 @@ fn finish(
     .map_err(io_at(&wet_csv))?;
     summary.artifacts.push(("wet areas".into(), wet_csv));
     // Splash heights.
+    let mut splash_scalars: Vec<(String, f64)> = Vec::new();
     if let Some(h) = &cfg.sensors.height {
         let x = h.reference_depth_m.unwrap_or(h.bin_m);
         // The plane counters are frozen when the window closes. A run that ends inside the window (before
@@ -433,11 +388,10 @@ fn finish(
         let (flux_up, flux_down, span) = if closed || !st.flux_started {
             (&st.flux_up, &st.flux_down, t1 - t0)
         } else {
-            log.line(&format!(
+            tracing::info!(
                 "splash heights: the run ended at t = {:.6} s inside the window [{t0}, {t1}] s; volumes and fluxes are averaged over [{t0}, {:.6}] s",
                 sim.time, sim.time
-            ))
-            .map_err(io_at(log_path))?;
+            );
             (&sim.flux_up, &sim.flux_down, st.height_time)
         };
         let mut rows = Vec::new();
@@ -475,6 +429,14 @@ fn finish(
         )
         .map_err(io_at(&p))?;
         summary.artifacts.push(("splash heights".into(), p));
+        // Volume-weighted mean height of the resident water and the highest bin holding any.
+        let total: f64 = vol_pts.iter().map(|(_, v)| v).sum();
+        if total > 0.0 {
+            let mean = vol_pts.iter().map(|(h, v)| h * v).sum::<f64>() / total;
+            let top = vol_pts.iter().filter(|(_, v)| *v > 0.0).map(|(h, _)| *h).fold(0.0, f64::max);
+            splash_scalars.push(("splash_mean_height_over_depth".into(), mean));
+            splash_scalars.push(("splash_top_bin_height_over_depth".into(), top));
+        }
         let png = dir.path("splash_height.png");
         spatter_io::plot::Chart::new("Splash height distribution", "height / depth", "mean volume [m³]")
             .line("resident volume per bin", &vol_pts)
@@ -494,7 +456,6 @@ fn finish(
         wall * threads as f64 / 3600.0,
         st.info.fluid_particles as f64 * sim.steps as f64 / wall.max(1e-9)
     );
-    log.line(&cost).map_err(io_at(log_path))?;
     let loads = sim.part_loads();
     summary.headline.push(format!(
         "t = {:.4} s in {} steps; {} particles left, {} removed (outside the domain) and {} (density window)",
@@ -511,7 +472,22 @@ fn finish(
             "{}: wet now {:.4e} m², mean wet {:.4e} m² of {:.4e} m²; fluid force [{:.4e}, {:.4e}, {:.4e}] N",
             p.name, wa.wet_now, wa.wet_mean, wa.area, f.x, f.y, f.z
         ));
+        summary.scalar(&format!("{}_wet_area_now_m2", p.name), wa.wet_now);
+        summary.scalar(&format!("{}_mean_wet_area_m2", p.name), wa.wet_mean);
+        let fraction = if wa.area > 0.0 { wa.wet_mean / wa.area } else { 0.0 };
+        summary.scalar(&format!("{}_mean_wet_fraction", p.name), fraction);
+        summary.scalar(&format!("{}_Fz_N", p.name), f.z);
     }
+    for (name, value) in [
+        ("t_end_s", sim.time),
+        ("steps", sim.steps as f64),
+        ("fluid_particles", sim.fluid.len() as f64),
+        ("removed_outside_domain", sim.removed.outside_domain as f64),
+        ("removed_density_window", sim.removed.density_window as f64),
+    ] {
+        summary.scalar(name, value);
+    }
+    summary.scalars.append(&mut splash_scalars);
     summary.headline.push(cost);
     summary.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
     summary.artifacts.push(("time series".into(), dir.path("series.csv")));
