@@ -9,8 +9,9 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 
-/// Files that legitimately differ between sessions: the log (timestamps) and the summary (wall time).
-const SESSION_FILES: &[&str] = &["log.txt", "summary.json"];
+/// Files that legitimately differ between sessions: the log (timestamps), the summary and the report
+/// (wall time).
+const SESSION_FILES: &[&str] = &["log.txt", "summary.json", "report.html"];
 
 fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
@@ -334,7 +335,9 @@ fn summary_json_carries_kind_scalars_and_artifacts() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(v["finished"], "completed");
     assert_eq!(v["kind"], "sph");
-    assert!(v["scalars"].as_object().is_some_and(|m| !m.is_empty()), "{v}");
+    let scalars = v["scalars"].as_array().expect("scalars as [name, value] pairs");
+    assert!(!scalars.is_empty(), "{v}");
+    assert!(scalars.iter().any(|p| p[0] == "tank_mean_wet_fraction"), "{v}");
     assert!(v["wall_time_s"].as_f64().is_some_and(|w| w > 0.0), "{v}");
     let artifacts = v["artifacts"].as_array().unwrap();
     assert!(!artifacts.is_empty());

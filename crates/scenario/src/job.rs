@@ -13,10 +13,11 @@
 //! starts (see [`spatter_io::checkpoint`]).
 
 use crate::kinds::{Loaded, RunError};
-use serde_json::{json, Map, Value};
+use serde_json::Value;
 use spatter_core::control::{Finished, RunControl};
 use spatter_io::checkpoint::fnv1a;
 use spatter_io::run::{RunContext, RunDir, RunSummary};
+use spatter_io::summary::SummaryFile;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -41,6 +42,9 @@ pub struct JobOptions {
     /// Wall-clock seconds between periodic checkpoints (> 0; default
     /// [`DEFAULT_CHECKPOINT_INTERVAL_S`]).
     pub checkpoint_interval_s: f64,
+    /// Files in `out` that belong to the caller (a study's `case.toml`): not another run's files, and
+    /// kept by `overwrite`.
+    pub keep: Vec<String>,
 }
 
 impl JobOptions {
@@ -51,6 +55,7 @@ impl JobOptions {
             resume: false,
             overwrite: false,
             checkpoint_interval_s: DEFAULT_CHECKPOINT_INTERVAL_S,
+            keep: Vec::new(),
         }
     }
 }
@@ -91,15 +96,20 @@ pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Resu
     }
     let resolved = loaded.scenario.resolved_toml().map_err(|e| JobError::Folder(e.to_string()))?;
     let hash = input_hash(&resolved);
-    let dir = prepare_folder(&opts.out, opts.resume, opts.overwrite, hash)?;
+    let dir = prepare_folder(opts, hash)?;
     dir.write_text("run.toml", &resolved)?;
     let earlier_wall_s = if opts.resume { earlier_wall_time(&dir) } else { 0.0 };
+    // The job's log; whatever log was open before (a study's own) is open again afterwards.
+    let previous_log = spatter_io::runlog::current();
     spatter_io::runlog::open(&dir.root().join("log.txt"), opts.resume)?;
     let result = run_in(loaded, &dir, opts, control, hash, earlier_wall_s);
     if let Err(e) = &result {
         tracing::error!("{e}");
     }
     spatter_io::runlog::close();
+    if let Some(p) = previous_log {
+        spatter_io::runlog::open(&p, true)?;
+    }
     result
 }
 
@@ -129,7 +139,7 @@ fn run_in(
         tracing::info!("{line}");
     }
     check_finite(dir.root(), &summary)?;
-    write_summary(dir, loaded.scenario.kind(), &summary, wall)?;
+    write_summary(dir, loaded, &summary, wall)?;
     match summary.finished {
         Finished::Completed => tracing::info!("completed in {wall:.3} s"),
         Finished::Interrupted => tracing::info!("interrupted after {wall:.3} s; checkpoint written"),
@@ -138,7 +148,8 @@ fn run_in(
 }
 
 /// Creates (or checks) the run folder.
-fn prepare_folder(out: &Path, resume: bool, overwrite: bool, hash: u64) -> Result<RunDir, JobError> {
+fn prepare_folder(opts: &JobOptions, hash: u64) -> Result<RunDir, JobError> {
+    let (out, resume, overwrite) = (opts.out.as_path(), opts.resume, opts.overwrite);
     if out.exists() && !out.is_dir() {
         return Err(JobError::Folder(format!("output {} exists and is not a folder", out.display())));
     }
@@ -155,7 +166,10 @@ fn prepare_folder(out: &Path, resume: bool, overwrite: bool, hash: u64) -> Resul
         return Ok(RunDir::create(out)?);
     }
     let entries: Vec<PathBuf> = match std::fs::read_dir(out) {
-        Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).collect(),
+        Ok(rd) => rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| !p.file_name().is_some_and(|n| opts.keep.iter().any(|k| n == k.as_str())))
+            .collect(),
         Err(_) => Vec::new(),
     };
     if !entries.is_empty() {
@@ -195,36 +209,15 @@ fn earlier_wall_time(dir: &RunDir) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// `summary.json`: what the run ended with, for studies (skip finished cases, results tables) and reports.
-fn write_summary(dir: &RunDir, kind: &str, s: &RunSummary, wall_s: f64) -> Result<(), JobError> {
-    let mut scalars = Map::new();
-    for (name, value) in &s.scalars {
-        scalars.insert(name.clone(), json!(value));
+/// `summary.json` (see [`spatter_io::summary`]): what the run ended with, for studies (skip finished
+/// cases, results tables) and reports; then `report.html` beside it.
+fn write_summary(dir: &RunDir, loaded: &Loaded, s: &RunSummary, wall_s: f64) -> Result<(), JobError> {
+    let kind = loaded.scenario.kind();
+    SummaryFile::of(s, kind, dir.root(), wall_s, rayon::current_num_threads()).write(dir.root())?;
+    let title = format!("{} — {kind}", loaded.source.path.display());
+    if let Err(e) = spatter_io::report::write_run_report(dir.root(), &title) {
+        tracing::warn!("no report.html: {e}");
     }
-    let root = dir.root();
-    let artifacts: Vec<Value> = s
-        .artifacts
-        .iter()
-        .map(|(label, path)| {
-            let rel = path.strip_prefix(root).unwrap_or(path);
-            json!([label, rel.to_string_lossy()])
-        })
-        .collect();
-    let warnings: Vec<&String> = s.headline.iter().filter(|l| l.starts_with("warning")).collect();
-    let v = json!({
-        "finished": match s.finished { Finished::Completed => "completed", Finished::Interrupted => "interrupted" },
-        "kind": kind,
-        "scalars": scalars,
-        "headline": s.headline,
-        "artifacts": artifacts,
-        "wall_time_s": wall_s,
-        "warnings": warnings,
-    });
-    let text = serde_json::to_string_pretty(&v).map_err(|e| JobError::Folder(e.to_string()))?;
-    // Written atomically: a study reading it never sees half a file.
-    let tmp = root.join("summary.json.tmp");
-    std::fs::write(&tmp, text + "\n")?;
-    std::fs::rename(&tmp, root.join("summary.json"))?;
     Ok(())
 }
 

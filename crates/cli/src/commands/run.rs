@@ -86,9 +86,9 @@ fn default_out(scenario: &Path) -> PathBuf {
     PathBuf::from("runs").join(stem)
 }
 
-/// Sets up the global thread pool: `threads` workers, refused when 0 or beyond
+/// Sets up the global thread pool (`--threads`; all cores when `None`): refused when 0 or beyond
 /// [`THREADS_PER_CPU_MAX`] per logical CPU.
-fn thread_pool(threads: Option<usize>) -> Result<()> {
+pub fn set_threads(threads: Option<usize>) -> Result<()> {
     let Some(n) = threads else { return Ok(()) };
     let cpus = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     anyhow::ensure!(n >= 1, "--threads 0: expected at least 1 worker thread");
@@ -103,7 +103,7 @@ fn thread_pool(threads: Option<usize>) -> Result<()> {
 }
 
 fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Result<ExitCode> {
-    thread_pool(args.threads)?;
+    set_threads(args.threads)?;
     install_signal_handler();
     let control = CliControl::new(args.quiet);
     if let Some(note) = crate::logging::init(control.bar(), args.verbose, args.quiet) {
@@ -114,6 +114,7 @@ fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Res
         resume: args.resume,
         overwrite: args.overwrite,
         checkpoint_interval_s: args.checkpoint_interval_s,
+        keep: Vec::new(),
     };
     let started = Instant::now();
     let result = job::run(&loaded, &opts, &control);

@@ -329,7 +329,7 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
     s.artifacts.push(("every impact".into(), impacts));
     let created = p.records.iter().filter(|r| r.result.created_energy()).count();
     energy_check(&mut s, created, p.records.len(), "energy_created = 1 in impacts.csv");
-    impact_scalars(&mut s, "", &p.records);
+    s.scalar("energy_created_impacts", created as f64);
     let n_d = cfg.grid.diameters;
     let n_v = cfg.grid.normal_speeds;
     for (ai, angle) in cfg.grid.angles_deg.iter().enumerate() {
@@ -370,6 +370,12 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
                     ctx.dir,
                 )?);
             }
+        }
+        if ai == 0 {
+            s.scalar("stick_count", regime::stick_count(recs) as f64);
+            s.scalar("impacts", recs.len() as f64);
+            s.scalar("stick_fraction", regime::stick_count(recs) as f64 / recs.len().max(1) as f64);
+            s.scalar("interface_diameters", iface.points.len() as f64);
         }
         let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
         let chart = output::regime_chart(&title, recs, &points, map.as_ref().map(|m| &m.v_crit_of_d), &axes);
@@ -456,13 +462,6 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
         impacts as usize,
         "counted per diameter in the energy_created column of critical_speeds.csv",
     );
-    s.scalar("impacts", impacts as f64);
-    s.scalar("energy_created_impacts", created as f64);
-    s.scalar("diameters_with_critical_speed", points.len() as f64);
-    // The critical speed at each diameter where the bisection found one (named by the diameter in µm).
-    for c in p.critical.iter().filter(|c| c.v_crit.is_finite()) {
-        s.scalar(&format!("v_crit_m_s_at_{}um", spatter_io::fmt_f64(c.diameter * 1e6)), c.v_crit);
-    }
     let found = points.len();
     s.headline.push(format!(
         "bisection: v_crit found for {found} of {} diameters with {impacts} impacts (relative tolerance {tol})",
@@ -479,6 +478,22 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     // Speeds at or below the highest sticking speed of each diameter stick.
     let grid_count: usize = p.critical.iter().map(|c| vs.iter().filter(|&&v| v <= c.low).count()).sum();
     s.headline.push(format!("equivalent grid stick count ({} speeds): {grid_count}", vs.len()));
+    if let (Some(a), Some(b)) = (points.first(), points.last()) {
+        s.scalar("v_crit_smallest_d_m_s", a[1]);
+        s.scalar("v_crit_largest_d_m_s", b[1]);
+        let mean_log = points.iter().map(|q| q[1].ln()).sum::<f64>() / points.len() as f64;
+        s.scalar("v_crit_geometric_mean_m_s", mean_log.exp());
+    }
+    s.scalar("diameters_with_v_crit", found as f64);
+    s.scalar("grid_stick_count", grid_count as f64);
+    s.scalar("impacts", f64::from(impacts));
+    s.scalar("energy_created_impacts", created as f64);
+    // The critical speed at each diameter where the bisection found one, named by the diameter in µm
+    // (rounded to 1e-6 µm so that a grid diameter such as 70 µm reads `70`, not `70.00000000000001`).
+    for c in p.critical.iter().filter(|c| c.v_crit.is_finite()) {
+        let um = (c.diameter * 1e12).round() / 1e6;
+        s.scalar(&format!("v_crit_m_s_at_{}um", spatter_io::fmt_f64(um)), c.v_crit);
+    }
     Ok(s)
 }
 
