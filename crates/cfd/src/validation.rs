@@ -500,9 +500,9 @@ mod turbulent_tests {
                 let path = dir.path().join("checkpoint.bin");
                 for s in 0..30 {
                     if Some(s) == split {
-                        spatter_io::checkpoint::save(&path, &f.state).unwrap();
+                        spatter_io::checkpoint::save(&path, 7, &f.state).unwrap();
                         f = build();
-                        f.restore(spatter_io::checkpoint::load(&path).unwrap()).unwrap();
+                        f.restore(spatter_io::checkpoint::load(&path, 7).unwrap()).unwrap();
                     }
                     let dt = f.stable_dt(0.5, 0.1);
                     f.step(dt).unwrap();

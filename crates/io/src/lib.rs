@@ -5,7 +5,8 @@
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
 //! * [`vtr`] — VTK XML rectilinear grids (structured flow fields);
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
-//! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
+//! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
+//! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
 //! * [`plot`] — PNG/SVG charts and mesh colour maps;
 //! * [`summary`] — `summary.json`, a run's result in machine-readable form;
 //! * [`report`] — self-contained HTML reports of runs and studies.
@@ -16,6 +17,7 @@ pub mod plot;
 pub mod pvd;
 pub mod report;
 pub mod run;
+pub mod runlog;
 pub mod summary;
 mod vtk_xml;
 pub mod vtr;

@@ -3,7 +3,7 @@
 //! boundary or cell named.
 
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
-use spatter_io::run::{RunContext, RunDir};
+use spatter_scenario::job::{self, JobOptions};
 use std::path::Path;
 
 const CAVITY: &str = include_str!("../../../examples/flow_cavity.toml");
@@ -28,14 +28,21 @@ fn load(dir: &Path, text: &str) -> Result<spatter_scenario::Loaded, String> {
     spatter_scenario::load(&p).map_err(|e| e.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("\n"))
 }
 
+/// The job driver points the process's one log at the running job's folder, so jobs in one process run
+/// one after another (as the cases of a study do).
+static ONE_JOB_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Runs `scenario` through the job driver (run folder, checkpoints, summary.json) into `out`.
 fn run(
     scenario: &spatter_scenario::Loaded,
     out: &Path,
     control: &dyn spatter_core::control::RunControl,
     resume: bool,
 ) -> Result<spatter_io::run::RunSummary, String> {
-    let dir = RunDir::create(out).unwrap();
-    scenario.scenario.run(&RunContext { dir: &dir, control, resume }).map_err(|e| e.to_string())
+    let mut opts = JobOptions::new(out);
+    opts.resume = resume;
+    let _one = ONE_JOB_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    job::run(scenario, &opts, control).map_err(|e| e.to_string())
 }
 
 #[test]
@@ -55,7 +62,17 @@ fn the_cavity_example_runs_and_a_resumed_run_writes_the_same_files() {
     assert!(scalar("probe_centre_ux_m_s").abs() < 0.3);
     assert!(scalar("net_outflow_m3_s").abs() < 1e-12, "closed cavity: no net flux");
     assert!(scalar("ghia_max_du").is_finite() && scalar("ghia_max_dv").is_finite());
-    for f in ["series.csv", "probes.csv", "fields.pvd", "speed.png", "centreline_u.png", "centreline_v.png"] {
+    for f in [
+        "series.csv",
+        "probes.csv",
+        "fields.pvd",
+        "speed.png",
+        "centreline_u.png",
+        "centreline_v.png",
+        "run.toml",
+        "summary.json",
+        "log.txt",
+    ] {
         assert!(whole.join(f).is_file(), "{f} missing");
     }
     let vtrs = std::fs::read_dir(whole.join("fields")).unwrap().count();
@@ -81,6 +98,28 @@ fn the_cavity_example_runs_and_a_resumed_run_writes_the_same_files() {
         let (a, b) = (std::fs::read(whole.join(&f)).unwrap(), std::fs::read(parts.join(&f)).unwrap());
         assert!(a == b, "{f} differs between the uninterrupted and the resumed run");
     }
+}
+
+#[test]
+fn max_steps_and_smoke_cut_the_run_short_but_write_every_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = small_cavity().replace("end_time_s = 2.0", "end_time_s = 2.0\nmax_steps = 7");
+    let sc = load(tmp.path(), &text).unwrap();
+    let s = run(&sc, &tmp.path().join("capped"), &Unattended, false).unwrap();
+    let scalar = |n: &str| s.scalars.iter().find(|(k, _)| k == n).map(|(_, v)| *v).unwrap();
+    assert_eq!(scalar("steps"), 7.0);
+    assert!(scalar("t_end_s") < 2.0);
+    let pvd = std::fs::read_to_string(tmp.path().join("capped/fields.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 2, "t = 0 and the last step: {pvd}");
+    // --smoke: at most 30 steps, the whole example otherwise.
+    let mut sc = load(tmp.path(), CAVITY).unwrap();
+    sc.scenario.smoke();
+    let s = run(&sc, &tmp.path().join("smoke"), &Unattended, false).unwrap();
+    let steps = s.scalars.iter().find(|(k, _)| k == "steps").map(|(_, v)| *v).unwrap();
+    assert_eq!(steps, 30.0);
+    assert!(tmp.path().join("smoke/centreline_u.png").is_file());
+    let e = load_error(&text.replace("max_steps = 7", "max_steps = 0"));
+    assert!(e.contains("time.max_steps"), "{e}");
 }
 
 #[test]

@@ -358,6 +358,10 @@ pub struct TimeSpec {
     /// falls below this \[m/s²\]; default: run to `end_time_s`.
     #[serde(default)]
     pub steady_rate_m_s2: Option<f64>,
+    /// Stop after this many steps even before `end_time_s` (a run cut short on purpose, e.g. a quick look
+    /// or `--smoke`); default: no limit.
+    #[serde(default)]
+    pub max_steps: Option<u64>,
 }
 
 impl Validate for TimeSpec {
@@ -365,6 +369,9 @@ impl Validate for TimeSpec {
         c.positive("end_time_s", self.end_time_s);
         if let Some(v) = self.steady_rate_m_s2 {
             c.positive("steady_rate_m_s2", v);
+        }
+        if self.max_steps == Some(0) {
+            c.fail("max_steps", "must be at least 1 (leave it out to run to end_time_s)");
         }
     }
 }
@@ -474,5 +481,13 @@ impl Validate for FlowConfig {
         c.item("numerics", &self.numerics);
         c.item("time", &self.time);
         c.item("output", &self.output);
+    }
+}
+
+impl spatter_io::run::Smoke for FlowConfig {
+    /// At most 30 steps; every output (fields at the start and the end, series, probes, pictures) is
+    /// still written.
+    fn smoke(&mut self) {
+        self.time.max_steps = Some(self.time.max_steps.map_or(30, |n| n.min(30)));
     }
 }

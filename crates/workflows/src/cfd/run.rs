@@ -176,7 +176,7 @@ pub fn run(cfg: &FlowConfig, ctx: &RunContext) -> Result<RunSummary, FlowRunErro
         }
     }
     let (mut st, mut series, mut probes, mut pvd) = if ctx.resume && ckpt.exists() {
-        let st: RunState = spatter_io::checkpoint::load(&ckpt)?;
+        let st: RunState = ctx.load_checkpoint()?;
         flow.restore(st.flow.clone())?;
         let series =
             CsvSeries::resume(&series_path, &SERIES, st.series_bytes).map_err(io_at(&series_path))?;
@@ -257,7 +257,8 @@ pub fn run(cfg: &FlowConfig, ctx: &RunContext) -> Result<RunSummary, FlowRunErro
                 st.next_sample += sample_dt;
             }
         }
-        let done = t >= end - eps || steady;
+        let capped = cfg.time.max_steps.is_some_and(|n| flow.state.step >= n);
+        let done = t >= end - eps || steady || capped;
         if t >= st.next_field - eps || done {
             write_field(&root, &mut pvd, &pvd_path, &flow, st.field_count)?;
             st.field_count += 1;
@@ -281,17 +282,25 @@ pub fn run(cfg: &FlowConfig, ctx: &RunContext) -> Result<RunSummary, FlowRunErro
                     st.rate
                 );
             }
+            if capped && !steady && t < end - eps {
+                tracing::info!("stopped after time.max_steps = {} steps at t = {t:.6} s", flow.state.step);
+            }
             break;
         }
-        if ctx.control.stop_requested() {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
             series.flush().map_err(io_at(&series_path))?;
             probes.flush().map_err(io_at(&probes_path))?;
             st.series_bytes = series.bytes_written();
             st.probes_bytes = probes.bytes_written();
-            st.wall_seconds += session.elapsed().as_secs_f64();
-            tracing::info!("stopped at t = {t:.6} s, step {}; checkpoint written", flow.state.step);
             st.flow = flow.state.clone();
-            spatter_io::checkpoint::save(&ckpt, &st)?;
+            let wall_before = st.wall_seconds;
+            st.wall_seconds += session.elapsed().as_secs_f64();
+            ctx.save_checkpoint(&st)?;
+            st.wall_seconds = wall_before;
+        }
+        if stop {
+            tracing::info!("stopped at t = {t:.6} s, step {}; checkpoint written", flow.state.step);
             let mut s = RunSummary::new(Finished::Interrupted);
             s.headline.push(format!("stopped at t = {t:.6} s of {end} s; resume to continue"));
             s.artifacts.push(("checkpoint".into(), ckpt));
@@ -308,7 +317,10 @@ pub fn run(cfg: &FlowConfig, ctx: &RunContext) -> Result<RunSummary, FlowRunErro
         st.last_iterations = rep.pressure.iterations;
         st.max_courant = st.max_courant.max(rep.courant);
         st.pressure_iterations += rep.pressure.iterations as u64;
-        let estimate = (end / dt.max(1e-300)) as u64;
+        let mut estimate = (end / dt.max(1e-300)) as u64;
+        if let Some(n) = cfg.time.max_steps {
+            estimate = estimate.min(n);
+        }
         ctx.control.progress(flow.state.step, estimate.max(flow.state.step));
     }
     series.flush().map_err(io_at(&series_path))?;
