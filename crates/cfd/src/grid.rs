@@ -359,6 +359,16 @@ impl Grid {
         m[0].wc[q[0]] * m[0].d[q[0]] * m[1].d[q[1]] * m[2].d[q[2]]
     }
 
+    /// Volume \[m³\] (per radian when axisymmetric) of the control volume of the velocity node of
+    /// component `a` at the +face of padded cell `q`: from centre to centre along `a`, the cell width
+    /// along the others.
+    pub fn node_volume(&self, a: usize, q: [usize; 3]) -> f64 {
+        let m = &self.metric;
+        let len = |b: usize| if b == a { m[b].dc[q[b]] } else { m[b].d[q[b]] };
+        let w = if a == 0 { m[0].wf[q[0]] } else { m[0].wc[q[0]] };
+        w * len(0) * len(1) * len(2)
+    }
+
     /// Area \[m²\] of the +face of padded cell `q` normal to axis `a`.
     pub fn face_area(&self, a: usize, q: [usize; 3]) -> f64 {
         let m = &self.metric;

@@ -6,6 +6,7 @@
 //! * [`regions`] — connected fluid regions and the mass balance each must satisfy;
 //! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
+//! * [`sources`] — momentum sources: actuator disks and point forces from particles;
 //! * [`turbulence`] — the standard k–ε model with wall functions;
 //! * [`solver`] — the projection method: Adams–Bashforth predictor, pressure correction, checks;
 //! * [`mg`] — geometric multigrid V-cycle for the pressure operator;
@@ -31,6 +32,7 @@ pub mod reduce;
 pub mod regions;
 pub mod solid;
 pub mod solver;
+pub mod sources;
 pub mod turbulence;
 pub mod validation;
 

@@ -326,6 +326,11 @@ impl Flow {
         self.pcg.mg.depth()
     }
 
+    /// Whether velocity node `c` of component `a` is updated by the momentum equation.
+    pub fn is_active_node(&self, a: usize, c: usize) -> bool {
+        self.kind[a][c] == ACTIVE
+    }
+
     /// Whether padded cell `c` is fluid.
     pub fn is_fluid(&self, c: usize) -> bool {
         self.grid.layout.interior(self.grid.layout.coords(c)) && !self.blocked[c]
@@ -729,18 +734,7 @@ impl Flow {
         }
         let mut out = [0.0; 3];
         for (comp, o) in out.iter_mut().enumerate() {
-            // Node coordinates of this component: faces along `comp`, centres along the others.
-            let mut base = [0usize; 3];
-            let mut w = [0.0f64; 3];
-            for a in 0..3 {
-                let m = &self.grid.metric[a];
-                let nodes = if a == comp { &m.xf } else { &m.xc };
-                // Largest padded index with node ≤ x (nodes are increasing).
-                let p = nodes.partition_point(|&v| v <= x[a]).clamp(1, l.p[a] - 1) - 1;
-                let t = ((x[a] - nodes[p]) / (nodes[p + 1] - nodes[p])).clamp(0.0, 1.0);
-                base[a] = p;
-                w[a] = t;
-            }
+            let (base, w) = trilinear_stencil(&self.grid, comp, x);
             let u = &nodes[comp];
             let mut v = 0.0;
             for dk in 0..2 {
@@ -797,6 +791,24 @@ impl Flow {
         }
         Ok(())
     }
+}
+
+/// The trilinear stencil of velocity component `comp` at point `x` (inside the grid): the padded
+/// coordinates of the lowest of the eight surrounding nodes and the weights along each axis. Nodes of a
+/// component sit at the faces along its own axis and at the centres along the others.
+pub fn trilinear_stencil(grid: &Grid, comp: usize, x: [f64; 3]) -> ([usize; 3], [f64; 3]) {
+    let l = grid.layout;
+    let mut base = [0usize; 3];
+    let mut w = [0.0f64; 3];
+    for a in 0..3 {
+        let m = &grid.metric[a];
+        let nodes = if a == comp { &m.xf } else { &m.xc };
+        // Largest padded index with node ≤ x (nodes are increasing).
+        let p = nodes.partition_point(|&v| v <= x[a]).clamp(1, l.p[a] - 1) - 1;
+        w[a] = ((x[a] - nodes[p]) / (nodes[p + 1] - nodes[p])).clamp(0.0, 1.0);
+        base[a] = p;
+    }
+    (base, w)
 }
 
 /// The pressure-correction operator of the node kinds.

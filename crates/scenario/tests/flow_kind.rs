@@ -186,6 +186,19 @@ fn bad_flow_input_is_refused_with_the_key_boundary_or_cell_named() {
         "x = { min_m = 0.0, max_m = 1.0, cells = 10000000 }",
     ));
     assert!(e.contains("grid.x.cells"), "{e}");
+    // An actuator disk on a Cartesian grid, and one with a sideways direction.
+    let e = load_error(&format!(
+        "{base}\n[[actuator_disks]]\nthrust_n = 1.0\nradius_m = 0.2\naxial_m = 0.5\ndirection = 0.5\n"
+    ));
+    assert!(e.contains("actuator_disks") && e.contains("axisymmetric"), "{e}");
+    assert!(e.contains("actuator_disks[0].direction"), "{e}");
+    let pipe = include_str!("../../../examples/flow_pipe_k_epsilon.toml");
+    let e = load_error(&format!(
+        "{pipe}\n[[actuator_disks]]\nthrust_n = 1.0\nradius_m = 0.2\naxial_m = 7.5\ntip_taper = 1.0\n"
+    ));
+    assert!(e.contains("actuator_disks[0].radius_m") && e.contains("grid.x.max_m"), "{e}");
+    assert!(e.contains("actuator_disks[0].axial_m") && e.contains("grid.y"), "{e}");
+    assert!(e.contains("actuator_disks[0].tip_taper"), "{e}");
     // An unknown key.
     let e = load_error(&base.replace("courant = 0.5", "courant = 0.5\ncfl = 0.5"));
     assert!(e.contains("cfl"), "{e}");

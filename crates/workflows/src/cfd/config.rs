@@ -21,6 +21,9 @@ pub struct FlowConfig {
     pub boundaries: BoundariesSpec,
     #[serde(default)]
     pub solids: Vec<Solid>,
+    /// Actuator disks (axisymmetric grids only).
+    #[serde(default)]
+    pub actuator_disks: Vec<spatter_cfd::sources::ActuatorDisk>,
     #[serde(default)]
     pub turbulence: TurbulenceSpec,
     #[serde(default)]
@@ -132,13 +135,14 @@ impl GridSpec {
         [self.x.cells, self.y.cells, self.z_axis().cells]
     }
 
-    /// Bytes the run will need: the solver's fields with the turbulence arrays ([`Flow::memory_estimate`])
-    /// plus the output buffers
-    /// of one snapshot (about 150 B per cell: cell fields, their copy in the writer and the base64 text).
+    /// Bytes the run will need: the solver's fields with the turbulence and body-force arrays (an upper
+    /// bound whether or not the run has k–ε or actuator disks, [`Flow::memory_estimate`]) plus the output
+    /// buffers of one snapshot (about 150 B per cell: cell fields, their copy in the writer and the base64
+    /// text).
     pub fn memory_estimate(&self) -> u64 {
         let n = self.cells();
         let cells = n.iter().map(|&v| v as u64).product::<u64>();
-        Flow::memory_estimate(n, false, true).saturating_add(cells.saturating_mul(150))
+        Flow::memory_estimate(n, true, true).saturating_add(cells.saturating_mul(150))
     }
 }
 
@@ -476,6 +480,36 @@ impl Validate for FlowConfig {
         c.item("boundaries", &self.boundaries);
         for (i, s) in self.solids.iter().enumerate() {
             c.element("solids", i, |c| s.validate(c));
+        }
+        let (r_max, (z_lo, z_hi)) = (self.grid.x.max_m, (self.grid.y.min_m, self.grid.y.max_m));
+        for (i, d) in self.actuator_disks.iter().enumerate() {
+            c.element("actuator_disks", i, |c| {
+                d.validate(c);
+                if d.radius_m > r_max {
+                    c.fail(
+                        "radius_m",
+                        format!(
+                            "= {} m reaches beyond the grid's radius grid.x.max_m = {r_max} m",
+                            d.radius_m
+                        ),
+                    );
+                }
+                if !(d.axial_m > z_lo && d.axial_m < z_hi) {
+                    c.fail(
+                        "axial_m",
+                        format!(
+                            "= {} m lies outside the grid's axial extent ({z_lo} m, {z_hi} m) (grid.y)",
+                            d.axial_m
+                        ),
+                    );
+                }
+            });
+        }
+        if !self.actuator_disks.is_empty() && self.grid.mode != Mode::Axisymmetric {
+            c.fail(
+                "actuator_disks",
+                "actuator disks need grid.mode = \"axisymmetric\" (the disk sits on the axis)",
+            );
         }
         c.item("turbulence", &self.turbulence);
         c.item("numerics", &self.numerics);

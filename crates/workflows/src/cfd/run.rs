@@ -72,6 +72,9 @@ pub fn build(cfg: &FlowConfig) -> Result<Flow, FlowRunError> {
     };
     let fluid = Fluid { density: cfg.fluid.density_kg_m3, viscosity: cfg.fluid.kinematic_viscosity_m2_s };
     let mut flow = Flow::new(grid, fluid, cfg.boundaries.sides(), blocked, numerics)?;
+    for (i, d) in cfg.actuator_disks.iter().enumerate() {
+        flow.add_actuator_disk(d).map_err(|e| FlowRunError::Setup(format!("actuator_disks[{i}]: {e}")))?;
+    }
     if let super::config::TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = cfg.turbulence
     {
         flow.enable_k_epsilon(spatter_cfd::turbulence::KEpsilon::standard(
@@ -425,6 +428,17 @@ fn finish(
     s.scalar("max_courant", st.max_courant);
     s.scalar("pressure_iterations_per_step", mean_iter);
     s.scalar("net_outflow_m3_s", flow.net_outflow());
+    for (i, d) in cfg.actuator_disks.iter().enumerate() {
+        let w = disk_mean_axial_speed(flow, d);
+        if !w.is_finite() {
+            continue; // a disk whose plane lies inside solids has no fluid to average
+        }
+        s.headline.push(format!(
+            "actuator disk {i}: mean axial speed through the disk {w:.4} m/s; momentum theory in hover √(T/(2ρA)) = {:.4} m/s",
+            d.hover_induced_velocity(cfg.fluid.density_kg_m3)
+        ));
+        s.scalar(&format!("disk_{i}_mean_axial_speed_m_s"), w);
+    }
     for p in &cfg.output.probes {
         if let Some((u, pr)) = probe(flow, p.at_m) {
             for (k, q) in ["ux_m_s", "uy_m_s", "uz_m_s"].iter().enumerate() {
@@ -434,6 +448,26 @@ fn finish(
         }
     }
     Ok(s)
+}
+
+/// Area-weighted mean of the axial velocity over the disk's radius at its axial position, sampled at the
+/// radial cell centres \[m/s\] (positive along the disk's `direction`).
+fn disk_mean_axial_speed(flow: &Flow, d: &spatter_cfd::sources::ActuatorDisk) -> f64 {
+    let ax = &flow.grid.axes[0];
+    let zc = 0.5 * (flow.grid.axes[2].lo() + flow.grid.axes[2].hi());
+    let (mut q, mut a) = (0.0, 0.0);
+    for i in (0..ax.n()).take_while(|&i| ax.centre(i) < d.radius_m) {
+        let (r, dr) = (ax.centre(i), ax.width(i));
+        if let Some(u) = flow.velocity_at([r, d.axial_m, zc]) {
+            q += u[1] * r * dr;
+            a += r * dr;
+        }
+    }
+    if a > 0.0 {
+        d.direction * q / a
+    } else {
+        f64::NAN
+    }
 }
 
 /// Samples the centrelines of the x–y box (taken as the unit cavity, velocities over the fastest wall
