@@ -29,7 +29,7 @@ use spatter_flow::tracker::walls::{Body, WallRule, WallRuleError, WallRuleSpec};
 use spatter_flow::tracker::{Status, TrackError, TrackSettings, Tracker, TrackerState};
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use std::path::PathBuf;
 
@@ -367,22 +367,31 @@ fn write_bodies(
             .cell_scalar("wall_shear_estimate_pa", &body.wall_shear)
             .write(&ctx.dir.path(&rel))?;
         summary.artifacts.push((format!("{} deposit (VTU)", body.name), ctx.dir.path(&rel)));
-        let (values, label) = match cfg.output.picture_quantity {
-            PictureQuantity::MassPerArea => (mpa.clone(), "deposited mass per area [kg/m²]"),
-            PictureQuantity::Impacts => (d.impacts.iter().map(|&i| i as f64).collect(), "impacts [parcels]"),
-            PictureQuantity::MeanNormalSpeed => (d.mean_vn(), "mean normal impact speed [m/s]"),
+        // The picture's values and the VTU array that holds them (a study redraws it from there).
+        let (values, label, array) = match cfg.output.picture_quantity {
+            PictureQuantity::MassPerArea => {
+                (mpa.clone(), "deposited mass per area [kg/m²]", "mass_per_area_kg_m2")
+            }
+            PictureQuantity::Impacts => {
+                (d.impacts.iter().map(|&i| i as f64).collect(), "impacts [parcels]", "impacts")
+            }
+            PictureQuantity::MeanNormalSpeed => {
+                (d.mean_vn(), "mean normal impact speed [m/s]", "mean_normal_speed_m_s")
+            }
         };
         let png = ctx.dir.path(&format!("{}_deposit.png", body.name));
-        spatter_io::plot::mesh_map_png(
-            &png,
-            m,
-            &values,
-            spec.view_direction,
-            spec.view_up,
-            &format!("{}: {}{partial_note}", body.name, label.split(" [").next().unwrap_or(label)),
-            label,
-        )?;
+        let title = format!("{}: {}{partial_note}", body.name, label.split(" [").next().unwrap_or(label));
+        spatter_io::plot::mesh_map_png(&png, m, &values, spec.view_direction, spec.view_up, &title, label)?;
         summary.artifacts.push((format!("{} deposit (PNG)", body.name), png));
+        summary.maps.push(MeshMapRecord {
+            label: format!("{} deposit", body.name),
+            vtu: ctx.dir.path(&rel),
+            array: array.to_owned(),
+            view_dir: spec.view_direction.to_array(),
+            up: spec.view_up.to_array(),
+            title,
+            colorbar_label: label.to_owned(),
+        });
         let mass: f64 = d.mass.iter().sum();
         let area: f64 = areas.iter().sum();
         let impacts: u64 = d.impacts.iter().sum();
