@@ -206,15 +206,19 @@ fn interrupted_and_resumed_runs_equal_uninterrupted_ones() {
 
 #[test]
 fn resume_refuses_a_different_configuration() {
+    // The checkpoint carries the hash of the input that wrote it (the job driver stamps the resolved
+    // input's hash); the snow run loads it through the context, so another input is refused.
     let root = tempfile::tempdir().unwrap();
     let cfg = small(Mode::Grid);
     let d = RunDir::create(root.path()).unwrap();
     let stop = StopAfterPolls::new(0);
-    assert_eq!(run(&cfg, &RunContext::new(&d, &stop, false)).unwrap().finished, Finished::Interrupted);
+    let first = RunContext { input_hash: 11, ..RunContext::new(&d, &stop, false) };
+    assert_eq!(run(&cfg, &first).unwrap().finished, Finished::Interrupted);
     let mut other = cfg.clone();
     other.grid.normal_speeds = 9;
-    let e = run(&other, &RunContext::new(&d, &Unattended, true)).unwrap_err();
-    assert!(e.to_string().contains("different configuration"), "{e}");
+    let e =
+        run(&other, &RunContext { input_hash: 12, ..RunContext::new(&d, &Unattended, true) }).unwrap_err();
+    assert!(e.to_string().contains("different scenario"), "{e}");
 }
 
 #[test]
