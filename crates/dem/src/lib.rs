@@ -4,6 +4,7 @@ pub mod adhesion;
 pub mod restitution_models;
 
 pub mod bench;
+pub mod clump;
 pub mod contact;
 pub mod error;
 pub mod insertion;

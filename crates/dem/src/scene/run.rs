@@ -214,6 +214,7 @@ fn run_with<L: ContactLaw>(
             (Some(a), Some(b)) => Some(Aabb::new(a, b)),
             _ => None,
         },
+        ..Default::default()
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method = if e.track_energy { e.energy_method } else { crate::sim::EnergyMethod::PerContact };

@@ -96,6 +96,9 @@ impl<L: ContactLaw> Simulation<L> {
                     }
                 },
             );
+            if !self.st.bodies.is_empty() {
+                self.clear_member_base_forces();
+            }
         }
         // External work uses the velocities at evaluation time (half-step velocities under Verlet).
         let mut ext_power = 0.0;
