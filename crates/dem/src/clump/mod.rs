@@ -12,8 +12,10 @@
 //! 4. members are placed rigidly, xᵢ = X + q rᵢ, vᵢ = V + ω × (q rᵢ), ωᵢ = ω.
 
 pub mod bodies;
+pub mod fill;
 pub mod mass;
 pub mod rotation;
+pub mod shapes;
 pub mod template;
 
 pub use bodies::{Bodies, NewBody, NO_BODY};
