@@ -16,6 +16,7 @@ pub mod sim;
 pub mod timestep;
 pub mod validation;
 pub mod walls;
+pub mod wear;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};

@@ -63,8 +63,9 @@ pub fn write_particles<L: ContactLaw>(sim: &Simulation<L>, path: &Path) -> io::R
 }
 
 /// Writes mesh wall `w` at its current position with the per-triangle impact records as cell data:
-/// `normal_impulse_N_s`, `tangential_impulse_N_s`, `impacts`, `mean_impact_speed_m_s`. Returns false for
-/// an analytic wall (nothing written).
+/// `normal_impulse_N_s`, `tangential_impulse_N_s`, `impacts`, `mean_impact_speed_m_s`,
+/// `mean_impact_angle_deg` (to the wall plane), `eroded_mass_kg` and `eroded_depth_m` (eroded mass over
+/// wall density × triangle area). Returns false for an analytic wall (nothing written).
 pub fn write_mesh<L: ContactLaw>(sim: &Simulation<L>, w: usize, path: &Path) -> io::Result<bool> {
     let wall = &sim.walls[w];
     let WallShape::Mesh(m) = &wall.shape else {
@@ -73,17 +74,20 @@ pub fn write_mesh<L: ContactLaw>(sim: &Simulation<L>, w: usize, path: &Path) -> 
     let k = WallKinematics::of(&wall.motion, sim.time());
     let verts: Vec<_> = m.mesh.vertices.iter().map(|v| k.pose.apply(*v)).collect();
     let r = &m.records;
-    let mean: Vec<f64> = r
-        .impact_speed_sum
-        .iter()
-        .zip(&r.impacts)
-        .map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 })
-        .collect();
+    let per_impact = |sum: &[f64]| -> Vec<f64> {
+        sum.iter().zip(&r.impacts).map(|(s, &n)| if n > 0 { s / n as f64 } else { 0.0 }).collect()
+    };
+    let rho = sim.materials()[wall.material as usize].density;
+    let depth: Vec<f64> =
+        r.eroded_mass.iter().enumerate().map(|(t, &dm)| dm / (rho * m.mesh.area(t))).collect();
     Vtu::triangles(&verts, &m.mesh.triangles)
         .cell_scalar("normal_impulse_N_s", &r.normal_impulse)
         .cell_scalar("tangential_impulse_N_s", &r.tangential_impulse)
         .cell_int("impacts", &r.impacts.iter().map(|&i| i as i64).collect::<Vec<_>>())
-        .cell_scalar("mean_impact_speed_m_s", &mean)
+        .cell_scalar("mean_impact_speed_m_s", &per_impact(&r.impact_speed_sum))
+        .cell_scalar("mean_impact_angle_deg", &per_impact(&r.impact_angle_sum))
+        .cell_scalar("eroded_mass_kg", &r.eroded_mass)
+        .cell_scalar("eroded_depth_m", &depth)
         .write(path)?;
     Ok(true)
 }

@@ -281,6 +281,8 @@ pub struct Simulation<L: ContactLaw> {
     pub(crate) st: DynState<L::State>,
     /// Clump templates (shapes of the rigid bodies).
     templates: Vec<crate::clump::ClumpTemplate>,
+    /// Erosion models per (particle material, wall material).
+    wear: crate::wear::WearTable,
     scratch: Scratch,
     external: Option<Box<dyn ExternalForces>>,
     /// Ids of the pair with the largest overlap in the last evaluation (second = `u32::MAX` for a wall).
@@ -322,6 +324,7 @@ impl<L: ContactLaw> Simulation<L> {
             energy_method: EnergyMethod::PerContact,
             st: DynState::default(),
             templates: Vec::new(),
+            wear: crate::wear::WearTable::new(0),
             scratch: Scratch::default(),
             external: None,
             last_worst: (0, 0),
@@ -425,7 +428,10 @@ impl<L: ContactLaw> Simulation<L> {
         }
         for (w, rec) in self.walls.iter_mut().zip(s.mesh_records) {
             match (&mut w.shape, rec) {
-                (WallShape::Mesh(m), Some(r)) if r.impacts.len() == m.mesh.triangles.len() => m.records = r,
+                (WallShape::Mesh(m), Some(r)) if r.impacts.len() == m.mesh.triangles.len() => {
+                    m.records = r;
+                    m.records.fill_missing();
+                }
                 (WallShape::Mesh(_), _) | (_, Some(_)) => {
                     return Err(format!("wall `{}` does not match the checkpoint", w.name));
                 }
@@ -451,6 +457,24 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.needs_rebuild = true;
         self.st.forces_valid = false;
         self.walls.len() - 1
+    }
+
+    /// Sets the erosion models of mesh walls (per particle material × wall material; see [`crate::wear`]).
+    pub fn set_wear(&mut self, table: crate::wear::WearTable) {
+        self.wear = table;
+    }
+
+    /// The erosion models in use.
+    pub fn wear(&self) -> &crate::wear::WearTable {
+        &self.wear
+    }
+
+    /// Total eroded mass of wall `w` \[kg\] (0 for an analytic wall).
+    pub fn eroded_mass(&self, w: usize) -> f64 {
+        match &self.walls[w].shape {
+            WallShape::Mesh(m) => m.records.eroded_mass.iter().sum(),
+            _ => 0.0,
+        }
     }
 
     /// Installs the external-force hook.
@@ -690,3 +714,5 @@ impl<L: ContactLaw> Simulation<L> {
 mod clump_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod wear_tests;
