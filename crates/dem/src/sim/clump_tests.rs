@@ -427,3 +427,19 @@ fn an_interrupted_and_resumed_clump_run_is_bit_identical() {
     second.run_steps(1300).unwrap();
     assert_eq!(snapshot(&whole), snapshot(&second));
 }
+
+/// Free fall: a clump under gravity alone follows x₀ + ½ g t² (velocity Verlet is exact for a constant
+/// force).
+#[test]
+fn a_clump_falls_freely_under_gravity() {
+    let m = soft();
+    let mut sim = two_material_sim(&m, 0.5, 0.5, 1e-4, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    let t = sim.add_template(tetra(1e-3));
+    sim.add_clump(t, 0, NewBody::at(Vec3::new(0.0, 0.0, 1.0), Quat::from_rotation_x(0.3))).unwrap();
+    sim.run_steps(1000).unwrap();
+    let b = sim.bodies();
+    let want = 1.0 - 0.5 * 9.81 * 0.1f64.powi(2);
+    assert!((b.pos[0].z - want).abs() < 1e-12, "z = {}, want {want}", b.pos[0].z);
+    assert!((b.vel[0].z + 9.81 * 0.1).abs() < 1e-12);
+}
