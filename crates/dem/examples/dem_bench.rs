@@ -38,7 +38,10 @@ fn main() {
             one.rate(),
             two.rate()
         );
-        for line in spatter_dem::bench::bench_clumps(&case, settle_steps, steps, one.rate(), two.rate())
+        let clump_settle: u64 = flag("--clump-settle")
+            .map(|s| s.parse().expect("--clump-settle N"))
+            .unwrap_or(spatter_dem::bench::CLUMP_SETTLE_STEPS);
+        for line in spatter_dem::bench::bench_clumps(&case, clump_settle, steps, one.rate(), two.rate())
             .expect("clumps")
         {
             println!("{line}");
