@@ -20,6 +20,7 @@ Examples:
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
   spatter bench dem                              # throughput of an engine
+  spatter sweep examples/snow_sobol_study.toml   # parameter study: results table, Sobol indices, report
   spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV
   spatter sessile --adhesion 0.6,0.8,1.0         # SPH contact angle per wall adhesion factor (calibration)";
 
@@ -117,6 +118,30 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Run a parameter study: every case of a study file (a base scenario and the keys to vary), then a
+    /// results table, plots, Sobol indices for sampled designs and report.html (docs/studies.md).
+    #[command(
+        args_conflicts_with_subcommands = true,
+        after_help = "Examples:\n  spatter sweep examples/snow_sobol_study.toml\n  spatter sweep study.toml --out runs/s --shard 3/8   # one task of a batch job array\n  spatter sweep collect study.toml --out runs/s        # table and report once every shard is done"
+    )]
+    Sweep {
+        #[command(subcommand)]
+        action: Option<SweepAction>,
+        /// Study file (TOML).
+        study: Option<PathBuf>,
+        /// Study folder [default: runs/<study file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run only shard i of n (every n-th case, starting at case i - 1), e.g. 2/8.
+        #[arg(long, value_parser = commands::sweep::parse_shard)]
+        shard: Option<(usize, usize)>,
+        /// Worker threads per case [default: all cores].
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Delete another study's cases found in the folder instead of refusing.
+        #[arg(long)]
+        overwrite: bool,
+    },
     /// Run a named benchmark and print its throughput.
     #[command(after_help = "Example:\n  spatter bench dem\n  spatter bench snow --quick")]
     Bench {
@@ -126,6 +151,18 @@ enum Command {
         /// A smaller case that finishes in seconds.
         #[arg(long)]
         quick: bool,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum SweepAction {
+    /// Build the results table, plots and report of a study whose shards have all finished.
+    Collect {
+        /// Study file (TOML).
+        study: PathBuf,
+        /// Study folder [default: runs/<study file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -139,6 +176,15 @@ fn main() -> ExitCode {
         Command::Demo { out, threads } => commands::run::demo(&out, threads),
         Command::Validate { quick, case, csv } => commands::validate(quick, case.as_deref(), csv.as_deref()),
         Command::Bench { engine, quick } => commands::bench(&engine, quick),
+        Command::Sweep { action: Some(SweepAction::Collect { study, out }), .. } => {
+            commands::sweep::collect(&study, out.as_deref())
+        }
+        Command::Sweep { action: None, study: Some(study), out, shard, threads, overwrite } => {
+            commands::sweep::sweep(&study, out.as_deref(), shard, threads, overwrite)
+        }
+        Command::Sweep { action: None, study: None, .. } => {
+            Err(anyhow::anyhow!("spatter sweep needs a study file: spatter sweep STUDY.toml (see --help)"))
+        }
         Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
         Command::Sessile {
             adhesion,

@@ -5,13 +5,17 @@
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
 //! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
-//! * [`plot`] — PNG/SVG charts and mesh colour maps.
+//! * [`plot`] — PNG/SVG charts and mesh colour maps;
+//! * [`summary`] — `summary.json`, a run's result in machine-readable form;
+//! * [`report`] — self-contained HTML reports of runs and studies.
 
 pub mod checkpoint;
 pub mod csv;
 pub mod plot;
 pub mod pvd;
+pub mod report;
 pub mod run;
+pub mod summary;
 pub mod vtu;
 
 /// Formats `x` so that it parses back to the same `f64` (shortest round-trip form), in exponent notation

@@ -2,6 +2,7 @@
 
 pub mod run;
 pub mod sessile;
+pub mod sweep;
 
 use crate::registry;
 use anyhow::Result;

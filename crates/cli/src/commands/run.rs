@@ -5,6 +5,7 @@ use crate::control::{install_ctrlc, CliControl};
 use anyhow::{Context, Result};
 use spatter_core::control::Finished;
 use spatter_io::run::{RunContext, RunDir};
+use spatter_io::summary::SummaryFile;
 use spatter_scenario::Loaded;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -40,6 +41,41 @@ pub fn demo(out: &Path, threads: Option<usize>) -> Result<ExitCode> {
     execute(loaded, out, threads, false, &format!("spatter run {name} --out {} --resume", out.display()))
 }
 
+/// Runs `loaded` in `dir` (whose `run.toml` is written), then writes `summary.json` and `report.html`
+/// there; returns the summary and the wall time \[s\].
+pub fn run_in_dir(
+    loaded: &Loaded,
+    dir: &RunDir,
+    control: &dyn spatter_core::control::RunControl,
+    resume: bool,
+) -> Result<(spatter_io::run::RunSummary, f64)> {
+    let ctx = RunContext { dir, control, resume };
+    let started = Instant::now();
+    let summary = loaded.scenario.run(&ctx).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let secs = started.elapsed().as_secs_f64();
+    let kind = loaded.scenario.kind();
+    SummaryFile::of(&summary, kind, dir.root(), secs, rayon::current_num_threads())
+        .write(dir.root())
+        .with_context(|| format!("cannot write the summary in {}", dir.root().display()))?;
+    let title = format!("{} — {kind}", loaded.source.path.display());
+    if let Err(e) = spatter_io::report::write_run_report(dir.root(), &title) {
+        tracing::warn!("no report.html: {e}");
+    }
+    Ok((summary, secs))
+}
+
+/// Sizes the global worker pool (`--threads`); all cores when `None`.
+pub fn set_threads(threads: Option<usize>) -> Result<()> {
+    if let Some(n) = threads {
+        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot set up worker threads")?;
+    }
+    Ok(())
+}
+
 fn default_out(scenario: &Path) -> PathBuf {
     let stem = scenario.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "run".into());
     PathBuf::from("runs").join(stem)
@@ -52,13 +88,7 @@ fn execute(
     resume: bool,
     resume_hint: &str,
 ) -> Result<ExitCode> {
-    if let Some(n) = threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot set up worker threads")?;
-    }
+    set_threads(threads)?;
     let dir = RunDir::create(out)?;
     let checkpoint = dir.checkpoint_path();
     if resume && !checkpoint.is_file() {
@@ -92,12 +122,9 @@ fn execute(
         if resume { " (resumed)" } else { "" }
     );
     tracing::info!("threads: {}", rayon::current_num_threads());
-    let ctx = RunContext { dir: &dir, control: &control, resume };
-    let started = Instant::now();
-    let result = loaded.scenario.run(&ctx);
+    let result = run_in_dir(&loaded, &dir, &control, resume);
     control.finish();
-    let summary = result.map_err(|e| anyhow::anyhow!("{e}"))?;
-    let secs = started.elapsed().as_secs_f64();
+    let (summary, secs) = result?;
     for line in &summary.headline {
         println!("{line}");
         tracing::info!("{line}");

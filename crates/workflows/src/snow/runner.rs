@@ -404,6 +404,12 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
                 )?);
             }
         }
+        if ai == 0 {
+            s.scalar("stick_count", regime::stick_count(recs) as f64);
+            s.scalar("impacts", recs.len() as f64);
+            s.scalar("stick_fraction", regime::stick_count(recs) as f64 / recs.len().max(1) as f64);
+            s.scalar("interface_diameters", iface.points.len() as f64);
+        }
         let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
         let chart = output::regime_chart(&title, recs, &points, map.as_ref().map(|m| &m.v_crit_of_d), &axes);
         let png = output::save_chart(&chart, ctx.dir, &format!("regime_map{suffix}"), cfg.svg)?;
@@ -504,6 +510,15 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     // Speeds at or below the highest sticking speed of each diameter stick.
     let grid_count: usize = p.critical.iter().map(|c| vs.iter().filter(|&&v| v <= c.low).count()).sum();
     s.headline.push(format!("equivalent grid stick count ({} speeds): {grid_count}", vs.len()));
+    if let (Some(a), Some(b)) = (points.first(), points.last()) {
+        s.scalar("v_crit_smallest_d_m_s", a[1]);
+        s.scalar("v_crit_largest_d_m_s", b[1]);
+        let mean_log = points.iter().map(|q| q[1].ln()).sum::<f64>() / points.len() as f64;
+        s.scalar("v_crit_geometric_mean_m_s", mean_log.exp());
+    }
+    s.scalar("diameters_with_v_crit", found as f64);
+    s.scalar("grid_stick_count", grid_count as f64);
+    s.scalar("impacts", f64::from(impacts));
     Ok(s)
 }
 
