@@ -3,57 +3,25 @@
 
 use super::*;
 use crate::clump::{ClumpTemplate, NewBody};
-use crate::contact::{HertzMindlin, PairProps, PairTable};
-use crate::validation::impact::rigid;
-use crate::walls::{MeshWall, Wall, WallShape};
-use crate::wear::{finnie_f, WearModel, WearTable};
+use crate::validation::wear::{panel_sim, single_impact};
+use crate::walls::WallShape;
+use crate::wear::{finnie_f, WearModel};
 use spatter_core::math::sphere_volume;
-use spatter_core::mesh::TriMesh;
-use spatter_core::motion::Motion;
 use spatter_core::Quat;
-
-fn panel_sim(n: usize, l: f64, model: WearModel) -> Simulation<HertzMindlin> {
-    let m = Material::new(1e8, 0.3, 2500.0).unwrap();
-    let wall = Material { density: 1200.0, ..rigid(0.3) };
-    let mats = vec![m, wall];
-    let pairs = PairTable::build(2, |a, b| PairProps::new(&mats[a], &mats[b], 0.3, 0.6));
-    let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, 1e-6, Settings::default());
-    sim.add_wall(Wall {
-        name: "panel".into(),
-        shape: WallShape::Mesh(Box::new(MeshWall::new(TriMesh::rectangle(l, l, 0.0, n, n)))),
-        material: 1,
-        motion: Motion::Fixed,
-    });
-    let mut w = WearTable::new(2);
-    w.set(0, 1, model);
-    sim.set_wear(w);
-    sim
-}
 
 /// One sphere hits the panel at γ = 30° to its plane with 2 m/s (no gravity): Finnie's eroded mass is
 /// k m v² f(30°) = k m v² cos²(30°)/3 with the velocity at first touch (the initial one), on one triangle,
 /// with one impact at 30°.
 #[test]
 fn a_single_oblique_impact_erodes_the_closed_form_mass() {
-    let mut sim = panel_sim(2, 0.04, WearModel::Finnie { k: 0.5 });
-    let r = 2e-3;
+    let k = 0.5;
+    let i = single_impact(WearModel::Finnie { k }, 30.0, 2.0, 2000).expect("the sphere hits the panel");
     let g = 30f64.to_radians();
-    let v = 2.0 * Vec3::new(g.cos(), 0.0, -g.sin());
-    let hit = Vec3::new(0.012, 0.006, 0.0); // inside one triangle's face
-    let x0 = hit + Vec3::new(0.0, 0.0, r) - v * (5e-5 / v.z.abs());
-    let mut p = crate::NewParticle::at(x0, r, 0);
-    p.vel = v;
-    sim.add_particle(p);
-    sim.run_steps(2000).unwrap();
-    let mass = 2500.0 * sphere_volume(r);
-    let want = 0.5 * mass * 4.0 * finnie_f(g);
-    let WallShape::Mesh(m) = &sim.walls[0].shape else { unreachable!() };
-    let rec = &m.records;
-    assert_eq!(rec.impacts.iter().sum::<u64>(), 1);
-    let t = rec.impacts.iter().position(|&k| k == 1).unwrap();
-    assert!((rec.eroded_mass[t] - want).abs() < 1e-12 * want, "{} against {want}", rec.eroded_mass[t]);
-    assert!((rec.impact_angle_sum[t] - 30.0).abs() < 1e-9);
-    assert!((sim.eroded_mass(0) - want).abs() < 1e-12 * want);
+    let want = k * i.mass * 4.0 * finnie_f(g);
+    assert_eq!(i.impacts, 1);
+    assert!((i.triangle_mass - want).abs() < 1e-12 * want, "{} against {want}", i.triangle_mass);
+    assert!((i.angle_deg - 30.0).abs() < 1e-9);
+    assert!((i.total_mass - want).abs() < 1e-12 * want);
     // Finnie f(30°) = cos²30°/3 = 0.25.
     assert!((finnie_f(g) - 0.25).abs() < 1e-15);
 }
