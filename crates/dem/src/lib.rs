@@ -11,7 +11,6 @@ pub mod insertion;
 pub mod output;
 pub mod par;
 pub mod particles;
-pub mod scene;
 pub mod sim;
 pub mod timestep;
 pub mod validation;
@@ -20,6 +19,5 @@ pub mod wear;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};
-pub use scene::{run, SceneConfig};
 pub use sim::{EnergyMethod, EnergyReport, Integrator, Settings, Simulation};
 pub use validation::validation_cases;
