@@ -509,6 +509,36 @@ pub fn mesh_map_png(
     title: &str,
     colorbar_label: &str,
 ) -> io::Result<()> {
+    mesh_map_png_on_scale(path, mesh, values, (view_dir, up), (title, colorbar_label), auto_scale(values))
+}
+
+/// The colour scale [`mesh_map_png`] chooses for `values`: from 0 (or the minimum, if negative) to the
+/// largest finite value; `(0, 1)` when there is nothing to scale.
+pub fn auto_scale(values: &[f64]) -> (f64, f64) {
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
+    let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
+    if vmax.is_finite() && vmax > vmin {
+        (vmin, vmax)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// [`mesh_map_png`] on a given colour scale `(low, high)` (values outside it take the end colours), so
+/// that maps of several runs can be compared colour for colour; `view` is (view direction, up) and
+/// `labels` (title, colour-bar label).
+pub fn mesh_map_png_on_scale(
+    path: &Path,
+    mesh: &TriMesh,
+    values: &[f64],
+    (view_dir, up): (Vec3, Vec3),
+    (title, colorbar_label): (&str, &str),
+    (vmin, vmax): (f64, f64),
+) -> io::Result<()> {
+    if !(vmin.is_finite() && vmax.is_finite() && vmax > vmin) {
+        return Err(err(path, format!("colour scale {vmin}..{vmax} must be finite and increasing")));
+    }
     if values.len() != mesh.triangles.len() {
         return Err(err(path, format!("{} values for {} triangles", values.len(), mesh.triangles.len())));
     }
@@ -532,11 +562,6 @@ pub fn mesh_map_png(
     if !x0.is_finite() {
         return Err(err(path, "mesh has no vertices"));
     }
-    let finite = values.iter().copied().filter(|v| v.is_finite());
-    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
-    let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
-    let (vmin, vmax) = if vmax.is_finite() && vmax > vmin { (vmin, vmax) } else { (0.0, 1.0) };
-
     // Painter's algorithm: far triangles first.
     let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
     let depth: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.centroid(t).dot(d)).collect();

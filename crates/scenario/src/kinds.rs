@@ -127,7 +127,13 @@ fn load_source(source: Source) -> Result<Loaded, Vec<ScenarioError>> {
                 &source,
                 0,
                 Some("kind".into()),
-                format!("missing key `kind` at the top of the file; expected {}", expected()),
+                if table.contains_key("base") && table.contains_key("vary") {
+                    "this is a parameter study (it has `base` and `[[vary]]`), not a scenario: run it with \
+                     `spatter sweep FILE`"
+                        .to_owned()
+                } else {
+                    format!("missing key `kind` at the top of the file; expected {}", expected())
+                },
             )])
         }
     };
