@@ -458,11 +458,27 @@ impl<L: ContactLaw> Simulation<L> {
         let wl = &self.st.wall_list;
         let p = &self.particles;
         let bodies = &self.st.bodies;
+        self.impacts.clear();
         for i in 0..p.len() {
             for k in wl.start[i] as usize..wl.start[i + 1] as usize {
                 let o = wl.out[k];
                 if !o.active {
                     continue;
+                }
+                if self.record_impacts && o.formed {
+                    let w = wl.wall[k] as usize;
+                    let wall = &self.walls[w];
+                    let (normal, v_wall) =
+                        super::impacts::contact_frame(wall, &self.scratch.kin[w], wl.tri[k], p.pos[i]);
+                    self.impacts.push(super::WallImpact {
+                        particle: p.id[i],
+                        body: p.is_member(i).then(|| bodies.id[p.body[i] as usize]),
+                        wall: w,
+                        triangle: matches!(wall.shape, WallShape::Mesh(_)).then_some(wl.tri[k]),
+                        time: self.st.time,
+                        normal,
+                        velocity: p.vel[i] - v_wall,
+                    });
                 }
                 let wall = &mut self.walls[wl.wall[k] as usize];
                 let wall_material = wall.material as usize;

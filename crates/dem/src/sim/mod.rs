@@ -18,9 +18,11 @@
 
 mod clumps;
 mod forces;
+mod impacts;
 mod integrate;
 mod neighbors;
 
+pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
 
@@ -284,6 +286,10 @@ pub struct Simulation<L: ContactLaw> {
     /// Erosion models per (particle material, wall material).
     wear: crate::wear::WearTable,
     scratch: Scratch,
+    /// Collect [`WallImpact`]s in every evaluation.
+    record_impacts: bool,
+    /// The wall contacts that formed in the last evaluation (when recording).
+    impacts: Vec<WallImpact>,
     external: Option<Box<dyn ExternalForces>>,
     /// Ids of the pair with the largest overlap in the last evaluation (second = `u32::MAX` for a wall).
     last_worst: (u32, u32),
@@ -326,6 +332,8 @@ impl<L: ContactLaw> Simulation<L> {
             templates: Vec::new(),
             wear: crate::wear::WearTable::new(0),
             scratch: Scratch::default(),
+            record_impacts: false,
+            impacts: Vec::new(),
             external: None,
             last_worst: (0, 0),
             base_forces_ready: false,
@@ -462,6 +470,18 @@ impl<L: ContactLaw> Simulation<L> {
     /// Sets the erosion models of mesh walls (per particle material × wall material; see [`crate::wear`]).
     pub fn set_wear(&mut self, table: crate::wear::WearTable) {
         self.wear = table;
+    }
+
+    /// Turns the recording of wall impacts on or off (off by default; see [`WallImpact`]).
+    pub fn set_impact_recording(&mut self, on: bool) {
+        self.record_impacts = on;
+        self.impacts.clear();
+    }
+
+    /// The particle–wall contacts that formed in the last force evaluation, in particle order (empty
+    /// unless recording is on).
+    pub fn last_impacts(&self) -> &[WallImpact] {
+        &self.impacts
     }
 
     /// The erosion models in use.

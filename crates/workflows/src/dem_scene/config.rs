@@ -524,11 +524,17 @@ pub struct OutputConfig {
     /// Mesh-wall VTU snapshots with impact records + `walls/<name>.pvd` (default true).
     #[serde(default = "yes")]
     pub mesh_vtu: bool,
+    /// `events.csv`: first wall impact, collisions per wall and a plane crossing per body or sphere.
+    #[serde(default)]
+    pub events: Option<super::events::EventsConfig>,
+    /// `trajectories.csv`: selected bodies and spheres every N steps.
+    #[serde(default)]
+    pub trajectories: Option<super::events::TrajectoryConfig>,
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { particles_vtu: true, mesh_vtu: true }
+        OutputConfig { particles_vtu: true, mesh_vtu: true, events: None, trajectories: None }
     }
 }
 
@@ -825,6 +831,14 @@ impl Validate for SceneConfig {
                 });
             });
         }
+        c.nested("output", |c| {
+            if let Some(e) = &self.output.events {
+                c.nested("events", |c| e.validate(c));
+            }
+            if let Some(t) = &self.output.trajectories {
+                c.nested("trajectories", |c| t.validate(c));
+            }
+        });
         let template_names: Vec<&str> = self.templates.keys().map(String::as_str).collect();
         for (name, t) in &self.templates {
             c.nested("templates", |c| {

@@ -3,6 +3,7 @@
 
 mod clumps;
 mod config;
+mod events;
 mod run;
 pub mod setup;
 

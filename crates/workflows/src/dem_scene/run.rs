@@ -1,6 +1,7 @@
 //! Running a scene: law selection, time loop, injection, outputs, checkpoint and resume.
 
 use super::config::{NormalKind, SceneConfig, TangentialKind};
+use super::events::{trajectory_rows, EventLog, TRAJECTORY_COLUMNS};
 use super::setup;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
@@ -34,6 +35,10 @@ struct Checkpoint<S> {
     /// Bytes written to `bodies.csv` and `wear.csv` (0 when not written).
     bodies_csv_bytes: u64,
     wear_csv_bytes: u64,
+    /// Bytes written to `trajectories.csv` (0 when not written).
+    trajectories_csv_bytes: u64,
+    /// The event log (empty when not kept).
+    events: EventLog,
     warnings: Vec<String>,
 }
 
@@ -160,6 +165,8 @@ struct Outputs {
     bodies: Option<CsvSeries>,
     /// `wear.csv` (scenes with a wear model).
     wear: Option<CsvSeries>,
+    /// `trajectories.csv` (with `[output.trajectories]`).
+    trajectories: Option<CsvSeries>,
     index: u64,
 }
 
@@ -198,7 +205,8 @@ fn series(path: &std::path::Path, columns: &[String], resume: Option<u64>) -> Re
 impl Outputs {
     /// Flushes the CSV series.
     fn flush(&mut self) -> Result<(), DemError> {
-        for s in [Some(&mut self.csv), self.bodies.as_mut(), self.wear.as_mut()].into_iter().flatten() {
+        let all = [Some(&mut self.csv), self.bodies.as_mut(), self.wear.as_mut(), self.trajectories.as_mut()];
+        for s in all.into_iter().flatten() {
             s.flush().map_err(|source| DemError::Io { path: s.path().to_owned(), source })?;
         }
         Ok(())
@@ -302,6 +310,10 @@ fn run_with<L: ContactLaw>(
     let bodies_path = dir.path("bodies.csv");
     let wear_path = dir.path("wear.csv");
     let body_columns: Vec<String> = BODY_COLUMNS.iter().map(|c| c.to_string()).collect();
+    let trajectories_path = dir.path("trajectories.csv");
+    let trajectory_columns: Vec<String> = TRAJECTORY_COLUMNS.iter().map(|c| c.to_string()).collect();
+    sim.set_impact_recording(cfg.output.events.is_some());
+    let mut events = EventLog::default();
     let warnings: Vec<String>;
     let mut out;
     if ctx.resume {
@@ -345,8 +357,15 @@ fn run_with<L: ContactLaw>(
                 true => Some(series(&wear_path, &wear_columns(&sim), Some(ck.wear_csv_bytes))?),
                 false => None,
             },
+            trajectories: match cfg.output.trajectories {
+                Some(_) => {
+                    Some(series(&trajectories_path, &trajectory_columns, Some(ck.trajectories_csv_bytes))?)
+                }
+                None => None,
+            },
             index: ck.output_index,
         };
+        events = ck.events;
         warnings = ck.warnings;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
@@ -380,6 +399,10 @@ fn run_with<L: ContactLaw>(
                 true => Some(series(&wear_path, &wear_columns(&sim), None)?),
                 false => None,
             },
+            trajectories: match cfg.output.trajectories {
+                Some(_) => Some(series(&trajectories_path, &trajectory_columns, None)?),
+                None => None,
+            },
             index: 0,
         };
         out.write(cfg, &sim, ctx)?;
@@ -397,9 +420,12 @@ fn run_with<L: ContactLaw>(
                 csv_bytes: out.csv.bytes_written(),
                 bodies_csv_bytes: out.bodies.as_ref().map_or(0, CsvSeries::bytes_written),
                 wear_csv_bytes: out.wear.as_ref().map_or(0, CsvSeries::bytes_written),
+                trajectories_csv_bytes: out.trajectories.as_ref().map_or(0, CsvSeries::bytes_written),
+                events: events.clone(),
                 warnings: warnings.clone(),
             };
             ctx.save_checkpoint(&ck)?;
+            write_events(cfg, &sim, &events, ctx)?;
         }
         if stop {
             let mut s = RunSummary::new(Finished::Interrupted);
@@ -420,6 +446,16 @@ fn run_with<L: ContactLaw>(
             sim.request_energy();
         }
         sim.step()?;
+        if let Some(e) = &cfg.output.events {
+            events.after_step(&sim, e);
+        }
+        if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, &mut out.trajectories) {
+            if sim.step_count() % tc.every_steps == 0 {
+                for row in trajectory_rows(&sim, tc) {
+                    tr.row(&row).map_err(io(tr.path()))?;
+                }
+            }
+        }
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {
             out.write(cfg, &sim, ctx)?;
         }
@@ -428,12 +464,45 @@ fn run_with<L: ContactLaw>(
         }
     }
     out.flush()?;
+    write_events(cfg, &sim, &events, ctx)?;
     let _ = std::fs::remove_file(dir.checkpoint_path());
     let mut s = summary(cfg, &sim, &injectors, &warnings, ctx);
+    if cfg.output.events.is_some() {
+        let (hit, crossed) = events.counts();
+        s.scalar("objects_hit_wall", hit as f64);
+        s.headline.push(format!("events: {hit} bodies/spheres hit a wall, {crossed} crossed the plane"));
+        if cfg.output.events.as_ref().is_some_and(|e| e.crossing_plane.is_some()) {
+            s.scalar("objects_crossed_plane", crossed as f64);
+        }
+        s.artifacts.push(("impact and crossing events".into(), ctx.dir.path("events.csv")));
+    }
+    if cfg.output.trajectories.is_some() {
+        s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
+    }
     for (name, png) in write_wear_maps(&sim, ctx)? {
         s.artifacts.push((format!("eroded mass map {name}"), png));
     }
     Ok(s)
+}
+
+/// Writes `events.csv` (the whole log so far; rewritten at every checkpoint and at the end) when the
+/// scene keeps an event log.
+fn write_events<L: ContactLaw>(
+    cfg: &SceneConfig,
+    sim: &Simulation<L>,
+    log: &EventLog,
+    ctx: &RunContext,
+) -> Result<(), DemError> {
+    if cfg.output.events.is_none() {
+        return Ok(());
+    }
+    let path = ctx.dir.path("events.csv");
+    let names: Vec<String> = sim.walls.iter().map(|w| w.name.clone()).collect();
+    let mut csv = series(&path, &EventLog::columns(&names), None)?;
+    for row in log.rows() {
+        csv.row(&row).map_err(|source| DemError::Io { path: path.clone(), source })?;
+    }
+    csv.flush().map_err(|source| DemError::Io { path: path.clone(), source })
 }
 
 /// For every mesh wall that a wear model applies to, `wear/<name>_eroded_mass.png`: the eroded mass per

@@ -626,3 +626,138 @@ fn a_stone_scene_runs_resumes_bit_for_bit_and_reports_its_wear() {
     assert!(full.root().join("wear/floor_eroded_mass.png").is_file());
     assert!(full.root().join("templates/pebble.vtu").is_file());
 }
+
+/// A sphere thrown at 1 m/s along x and 1 m/s down onto an STL floor, a pebble thrown down beside it; events
+/// with the impact angle also seen in the x–z plane and the crossing of the plane x = 0.03 m;
+/// trajectories of the first body and sphere.
+fn events_toml(dir: &Path) -> String {
+    format!(
+        r#"
+dt_s = 1e-5
+duration_s = 0.03
+output_interval_s = 0.01
+gravity_m_s2 = [0, 0, -9.81]
+
+[materials.grain]
+youngs_modulus_pa = 5e7
+poisson_ratio = 0.3
+density_kg_m3 = 2500
+
+[pair_defaults]
+friction = 0.3
+restitution = 0.5
+
+[[walls]]
+name = "floor"
+material = "grain"
+shape = {{ type = "mesh", file = "{}" }}
+
+[templates.pebble]
+shape = {{ type = "ellipsoid", semi_axes_m = [0.004, 0.003, 0.0025] }}
+packing = {{ type = "equal", sphere_diameter_m = 0.0016 }}
+
+[[fill]]
+material = "grain"
+region = {{ type = "box", min_m = [0.0178, 0.0178, 0.0078], max_m = [0.0222, 0.0222, 0.0122] }}
+size = {{ kind = "mono", diameter = 0.004 }}
+count = 1
+velocity_m_s = [1, 0, -1]
+
+[[fill]]
+material = "grain"
+region = {{ type = "box", min_m = [0.04, 0.045, 0.006], max_m = [0.06, 0.065, 0.02] }}
+clumps = {{ templates = ["pebble"] }}
+count = 1
+velocity_m_s = [0, 0, -1]
+
+[output.events]
+angle_plane_normal = [0, 1, 0]
+crossing_plane = {{ point_m = [0.03, 0, 0], normal = [1, 0, 0] }}
+
+[output.trajectories]
+every_steps = 100
+first = 1
+"#,
+        floor_stl(dir).display()
+    )
+}
+
+fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let head = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    (head, rows)
+}
+
+#[test]
+fn the_event_log_records_first_impacts_and_plane_crossings_and_resumes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = parse(&events_toml(tmp.path()));
+    Checker::run(&cfg, None).unwrap();
+    let full = RunDir::create(&tmp.path().join("full")).unwrap();
+    let s = run(&cfg, &RunContext::new(&full, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.finished, Finished::Completed);
+    let part = RunDir::create(&tmp.path().join("part")).unwrap();
+    assert_eq!(
+        run(&cfg, &RunContext::new(&part, &StopAfterPolls::new(1234), false)).unwrap().finished,
+        Finished::Interrupted
+    );
+    assert_eq!(run(&cfg, &RunContext::new(&part, &Unattended, true)).unwrap().finished, Finished::Completed);
+    for rel in ["events.csv", "trajectories.csv"] {
+        let a = std::fs::read(full.root().join(rel)).unwrap();
+        let b = std::fs::read(part.root().join(rel)).unwrap();
+        assert!(a == b, "{rel} differs between the uninterrupted and the resumed run");
+    }
+    let (head, rows) = csv_rows(&full.root().join("events.csv"));
+    let col = |k: &str| head.iter().position(|h| h == k).unwrap_or_else(|| panic!("no column {k}: {head:?}"));
+    // Bodies first: the pebble (body 0, template 0), then the sphere (particle id 0, filled first).
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    let (body, sphere) = (&rows[0], &rows[1]);
+    assert_eq!((body[col("body")], body[col("id")], body[col("template")]), (1.0, 0.0, 0.0));
+    assert_eq!((sphere[col("body")], sphere[col("id")], sphere[col("template")]), (0.0, 0.0, -1.0));
+    // The sphere falls from its start height h = z0 − r (from the first particle VTU) to touch at 1 m/s
+    // along x: v_z² = 1 + 2 g h, so the impact angle is atan(|v_z|/1) ≈ 54° (to 0.02°: the event takes
+    // the half-step velocity, g Δt/2 = 5e-5 m/s, of the step in which the contact formed); in the x–z
+    // plane the same angle (the velocity lies in it).
+    let first = spatter_io::vtu::read(&full.root().join("particles/particles_00000.vtu")).unwrap();
+    let free = first.point_data["body_id"].1.iter().position(|&b| b < 0.0).unwrap();
+    let h = first.points[free].z - 0.002;
+    let vz = (1.0 + 2.0 * 9.81 * h).sqrt();
+    let angle = vz.atan().to_degrees();
+    assert!(
+        (sphere[col("first_impact_angle_deg")] - angle).abs() < 0.02,
+        "{} vs {angle}",
+        sphere[col("first_impact_angle_deg")]
+    );
+    assert!(
+        (sphere[col("first_impact_plane_angle_deg")] - sphere[col("first_impact_angle_deg")]).abs() < 1e-9
+    );
+    assert!((sphere[col("first_impact_speed_m_s")] - vz.hypot(1.0)).abs() < 1e-3);
+    assert!((sphere[col("first_impact_normal_speed_m_s")] - vz).abs() < 1e-3);
+    // Touch after t = (vz − 1)/g ≈ 7 ms, within a step.
+    let t_touch = (vz - 1.0) / 9.81;
+    assert!((sphere[col("first_impact_t_s")] - t_touch).abs() < 2e-5, "{}", sphere[col("first_impact_t_s")]);
+    assert_eq!(sphere[col("first_impact_wall")], 0.0);
+    assert!(sphere[col("first_impact_triangle")] >= 0.0);
+    assert!(sphere[col("collisions_floor")] >= 1.0);
+    // The pebble, thrown down at 1 m/s from at most 2 cm, lands within 20 ms.
+    assert!(body[col("first_impact_t_s")] < 0.02, "{body:?}");
+    assert!(body[col("collisions_floor")] >= 1.0);
+    assert!(body[col("first_impact_angle_deg")] > 80.0, "{body:?}");
+    // The sphere crosses x = 0.03 m moving along +x after ~10 ms (1 m/s from x ≈ 0.02 m, slowed by
+    // friction at the bounce); the pebble never does.
+    let t_cross = sphere[col("crossing_t_s")];
+    assert!(t_cross > 0.0097 && t_cross < 0.02, "{t_cross}");
+    assert!(sphere[col("crossing_dir_x")] > 0.5);
+    assert!((sphere[col("crossing_x_m")] - 0.03).abs() < 2e-5);
+    assert!(body[col("crossing_t_s")].is_nan());
+    // Trajectories: body 0 and sphere 0 every 100 steps (3000 steps: 30 rows each).
+    let (thead, trows) = csv_rows(&full.root().join("trajectories.csv"));
+    assert_eq!(thead[..3], ["t_s", "body", "id"]);
+    assert_eq!(trows.len(), 60);
+    assert!(trows.iter().all(|r| r[2] == 0.0));
+    assert_eq!(trows.iter().filter(|r| r[1] == 1.0).count(), 30);
+    assert_eq!(scalar(&s, "objects_hit_wall"), Some(2.0));
+    assert_eq!(scalar(&s, "objects_crossed_plane"), Some(1.0));
+}

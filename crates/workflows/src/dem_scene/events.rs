@@ -1,0 +1,335 @@
+//! Event log and trajectories of a scene (`[output.events]`, `[output.trajectories]`): per body or free
+//! sphere its first wall impact (time, wall, triangle, speed, angle in space and in a chosen plane), its
+//! wall collisions per wall and its first crossing of a chosen plane; and the motion of selected bodies
+//! and spheres every N steps.
+//!
+//! Objects are keyed by kind and stable id: a rigid body by its body id, a free sphere by its particle
+//! id. Both are numbered from 0 in insertion order (bodies and particles separately; members take
+//! particle ids too). The log reads the engine's [`WallImpact`]s after every step and is checkpointed
+//! with the scene, so an interrupted and resumed run writes the same files.
+
+use serde::{Deserialize, Serialize};
+use spatter_core::check::Checker;
+use spatter_core::Vec3;
+use spatter_dem::clump::NO_BODY;
+use spatter_dem::contact::ContactLaw;
+use spatter_dem::sim::{Simulation, WallImpact};
+use std::collections::BTreeMap;
+
+/// `[output.events]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EventsConfig {
+    /// Normal of the plane in which impact angles are also measured (e.g. `[1, 0, 0]`: the angle seen in
+    /// the y–z plane). Without it that column is NaN.
+    #[serde(default)]
+    pub angle_plane_normal: Option<Vec3>,
+    /// A plane whose first crossing by each body or sphere is recorded, `{ point_m, normal }`.
+    #[serde(default)]
+    pub crossing_plane: Option<CrossingPlane>,
+}
+
+/// A plane through `point_m` with normal `normal` (need not be unit length).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrossingPlane {
+    pub point_m: Vec3,
+    pub normal: Vec3,
+}
+
+/// `[output.trajectories]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrajectoryConfig {
+    /// A row per selected object every this many steps.
+    pub every_steps: u64,
+    /// Ids to follow (body ids for bodies, particle ids for free spheres).
+    #[serde(default)]
+    pub ids: Vec<u32>,
+    /// Also follow every object whose id is below this: the first K inserted bodies and spheres.
+    #[serde(default)]
+    pub first: u32,
+}
+
+impl EventsConfig {
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        if let Some(m) = self.angle_plane_normal {
+            check_direction(c, "angle_plane_normal", m);
+        }
+        if let Some(p) = &self.crossing_plane {
+            c.nested("crossing_plane", |c| {
+                c.finite_vec("point_m", p.point_m);
+                check_direction(c, "normal", p.normal);
+            });
+        }
+    }
+}
+
+impl TrajectoryConfig {
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        if self.every_steps == 0 {
+            c.fail("every_steps", "every_steps = 0: give a positive number of steps".to_string());
+        }
+        if self.ids.is_empty() && self.first == 0 {
+            c.fail("ids", "select objects to follow: ids = [...] and/or first = K".to_string());
+        }
+    }
+
+    /// Whether the object with this id is followed.
+    fn follows(&self, id: u32) -> bool {
+        id < self.first || self.ids.contains(&id)
+    }
+}
+
+fn check_direction(c: &mut Checker, key: &str, v: Vec3) {
+    c.finite_vec(key, v);
+    if v.length() == 0.0 {
+        c.fail(key, format!("{key} = [0, 0, 0] is not a direction"));
+    }
+}
+
+/// A body (`true`) or a free sphere (`false`) and its stable id.
+type Key = (bool, u32);
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct FirstImpact {
+    t: f64,
+    wall: usize,
+    triangle: Option<u32>,
+    speed: f64,
+    normal_speed: f64,
+    angle_deg: f64,
+    plane_angle_deg: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct Crossing {
+    t: f64,
+    pos: Vec3,
+    dir: Vec3,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+struct ObjectRecord {
+    /// Template index of a body, −1 for a sphere.
+    template: i64,
+    first: Option<FirstImpact>,
+    /// Contacts formed per wall (a body touching a wall with several members in one step counts once).
+    collisions: Vec<u64>,
+    /// Signed distance to the crossing plane after the last step (NaN before the first).
+    side: f64,
+    crossing: Option<Crossing>,
+}
+
+/// The state of the event log (checkpointed).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EventLog {
+    records: BTreeMap<Key, ObjectRecord>,
+}
+
+impl EventLog {
+    fn record(&mut self, key: Key, template: i64, walls: usize) -> &mut ObjectRecord {
+        self.records.entry(key).or_insert_with(|| ObjectRecord {
+            template,
+            collisions: vec![0; walls],
+            side: f64::NAN,
+            ..Default::default()
+        })
+    }
+
+    /// Takes in the wall impacts of the last step and the plane crossings.
+    pub fn after_step<L: ContactLaw>(&mut self, sim: &Simulation<L>, cfg: &EventsConfig) {
+        let t = sim.time();
+        let walls = sim.walls.len();
+        let bodies = sim.bodies();
+        let template_of = |b: u32| -> i64 {
+            // Body ids grow in insertion order and removal keeps the order: the ids are sorted.
+            bodies.id.binary_search(&b).map_or(-1, |k| bodies.template[k] as i64)
+        };
+        let plane = cfg.angle_plane_normal.map(|m| m.normalize());
+        let mut counted: Vec<(Key, usize)> = Vec::new();
+        for imp in sim.last_impacts() {
+            let key: Key = match imp.body {
+                Some(b) => (true, b),
+                None => (false, imp.particle),
+            };
+            let template = imp.body.map_or(-1, template_of);
+            let rec = self.record(key, template, walls);
+            if !counted.contains(&(key, imp.wall)) {
+                counted.push((key, imp.wall));
+                rec.collisions[imp.wall] += 1;
+            }
+            let candidate = first_impact(imp, plane);
+            // Among the contacts of one object that form in the same step, the fastest normal approach.
+            match &mut rec.first {
+                None => rec.first = Some(candidate),
+                Some(f) if f.t == t && candidate.normal_speed > f.normal_speed => *f = candidate,
+                Some(_) => {}
+            }
+        }
+        if let Some(pl) = &cfg.crossing_plane {
+            let n = pl.normal.normalize();
+            let p = &sim.particles;
+            let check = |key: Key, template: i64, x: Vec3, v: Vec3, log: &mut Self| {
+                let s = (x - pl.point_m).dot(n);
+                let rec = log.record(key, template, walls);
+                if rec.crossing.is_none() && rec.side.is_finite() && (rec.side < 0.0) != (s < 0.0) {
+                    rec.crossing = Some(Crossing { t, pos: x, dir: v.normalize_or_zero() });
+                }
+                rec.side = s;
+            };
+            for k in 0..bodies.len() {
+                check((true, bodies.id[k]), bodies.template[k] as i64, bodies.pos[k], bodies.vel[k], self);
+            }
+            for i in (0..p.len()).filter(|&i| p.body[i] == NO_BODY) {
+                check((false, p.id[i]), -1, p.pos[i], p.vel[i], self);
+            }
+        }
+    }
+
+    /// Columns of `events.csv` for a scene with these wall names.
+    pub fn columns(wall_names: &[String]) -> Vec<String> {
+        let mut c: Vec<String> = [
+            "body",
+            "id",
+            "template",
+            "first_impact_t_s",
+            "first_impact_wall",
+            "first_impact_triangle",
+            "first_impact_speed_m_s",
+            "first_impact_normal_speed_m_s",
+            "first_impact_angle_deg",
+            "first_impact_plane_angle_deg",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        c.extend(wall_names.iter().map(|w| format!("collisions_{w}")));
+        c.extend(
+            [
+                "crossing_t_s",
+                "crossing_x_m",
+                "crossing_y_m",
+                "crossing_z_m",
+                "crossing_dir_x",
+                "crossing_dir_y",
+                "crossing_dir_z",
+            ]
+            .iter()
+            .map(|s| s.to_string()),
+        );
+        c
+    }
+
+    /// Rows of `events.csv`: one per body or sphere that hit a wall or was checked against the crossing
+    /// plane, bodies first, by id; NaN where an event did not happen (the wall index is −1 then).
+    pub fn rows(&self) -> Vec<Vec<f64>> {
+        let nan = f64::NAN;
+        let mut keys: Vec<&Key> = self.records.keys().collect();
+        keys.sort_by_key(|k| (!k.0, k.1));
+        keys.into_iter()
+            .map(|k| {
+                let r = &self.records[k];
+                let mut row = vec![k.0 as u8 as f64, k.1 as f64, r.template as f64];
+                match &r.first {
+                    Some(f) => row.extend([
+                        f.t,
+                        f.wall as f64,
+                        f.triangle.map_or(-1.0, |t| t as f64),
+                        f.speed,
+                        f.normal_speed,
+                        f.angle_deg,
+                        f.plane_angle_deg,
+                    ]),
+                    None => row.extend([nan, -1.0, -1.0, nan, nan, nan, nan]),
+                }
+                row.extend(r.collisions.iter().map(|&c| c as f64));
+                match &r.crossing {
+                    Some(c) => row.extend([c.t, c.pos.x, c.pos.y, c.pos.z, c.dir.x, c.dir.y, c.dir.z]),
+                    None => row.extend([nan; 7]),
+                }
+                row
+            })
+            .collect()
+    }
+
+    /// Objects that hit a wall, and objects that crossed the plane.
+    pub fn counts(&self) -> (usize, usize) {
+        let hit = self.records.values().filter(|r| r.first.is_some()).count();
+        let crossed = self.records.values().filter(|r| r.crossing.is_some()).count();
+        (hit, crossed)
+    }
+}
+
+fn first_impact(imp: &WallImpact, plane: Option<Vec3>) -> FirstImpact {
+    FirstImpact {
+        t: imp.time,
+        wall: imp.wall,
+        triangle: imp.triangle,
+        speed: imp.speed(),
+        normal_speed: -imp.velocity.dot(imp.normal),
+        angle_deg: imp.angle_deg(),
+        plane_angle_deg: plane.map_or(f64::NAN, |m| imp.angle_in_plane_deg(m)),
+    }
+}
+
+/// Columns of `trajectories.csv`.
+pub const TRAJECTORY_COLUMNS: &[&str] = &[
+    "t_s", "body", "id", "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "qw", "qx", "qy", "qz",
+    "wx_rad_s", "wy_rad_s", "wz_rad_s",
+];
+
+/// Rows of `trajectories.csv` at the current time: the followed bodies (centre of mass, orientation of the
+/// principal frame) then the followed free spheres (orientation 1, 0, 0, 0: spheres carry none).
+pub fn trajectory_rows<L: ContactLaw>(sim: &Simulation<L>, cfg: &TrajectoryConfig) -> Vec<Vec<f64>> {
+    let t = sim.time();
+    let b = sim.bodies();
+    let p = &sim.particles;
+    let mut rows = Vec::new();
+    for k in (0..b.len()).filter(|&k| cfg.follows(b.id[k])) {
+        let (x, v, q, w) = (b.pos[k], b.vel[k], b.quat[k], b.omega[k]);
+        rows.push(vec![
+            t,
+            1.0,
+            b.id[k] as f64,
+            x.x,
+            x.y,
+            x.z,
+            v.x,
+            v.y,
+            v.z,
+            q.w,
+            q.x,
+            q.y,
+            q.z,
+            w.x,
+            w.y,
+            w.z,
+        ]);
+    }
+    let mut spheres: Vec<usize> =
+        (0..p.len()).filter(|&i| p.body[i] == NO_BODY && cfg.follows(p.id[i])).collect();
+    spheres.sort_by_key(|&i| p.id[i]);
+    for i in spheres {
+        let (x, v, w) = (p.pos[i], p.vel[i], p.omega[i]);
+        rows.push(vec![
+            t,
+            0.0,
+            p.id[i] as f64,
+            x.x,
+            x.y,
+            x.z,
+            v.x,
+            v.y,
+            v.z,
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            w.x,
+            w.y,
+            w.z,
+        ]);
+    }
+    rows
+}
