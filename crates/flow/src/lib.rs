@@ -4,6 +4,8 @@
 //!   gradient, gravity/buoyancy, wall-bounded lift) and the nondimensional force ranking;
 //! * [`field`] — flow fields: analytic (uniform, stagnation point, vortices, wall jet, rotor downwash) and
 //!   imported from VTK files ([`vtk`]), with point location and interpolation, and turbulent dispersion;
+//! * [`liftoff`] — wall shear along the ground, Shields exceedance, the asperity moment balance and the
+//!   lift-off map;
 //! * [`tracker`] — parcels, injection, the integrator, wall rules on STL bodies, deposition statistics
 //!   and the exact mass balance;
 //! * [`validation`] — reference cases for `spatter validate`; [`bench`] — `spatter bench track`.
@@ -17,6 +19,7 @@
 pub mod bench;
 pub mod field;
 pub mod forces;
+pub mod liftoff;
 pub mod tracker;
 pub mod validation;
 pub mod vtk;
