@@ -7,8 +7,11 @@
 //! * [`shields`] — the Shields parameter and its critical values;
 //! * [`incipient`] — the moment balance of a grain on two bed grains about the downwind asperity (drag,
 //!   wall lift, cohesion, weight) and the lift-off balance, with their critical friction velocities;
-//! * [`map`] — the lift-off map (ground distance × grain size) as CSV and PNG.
+//! * [`map`] — the lift-off map (ground distance × grain size) as CSV and PNG;
+//! * [`entrainment`] — the empirical entrainment models (Bagnold / Shao–Lu thresholds, Haehnel,
+//!   Wachspress, White / Phillips–Brown) and the mass lifted per ground annulus.
 
+pub mod entrainment;
 pub mod ground_shear;
 pub mod incipient;
 pub mod map;
