@@ -16,7 +16,8 @@ Examples:
   spatter demo                                   # snow regime map on the built-in scenario, no files needed
   spatter run examples/snow_regime_map.toml      # run a scenario; results in runs/snow_regime_map/
   spatter run study.toml --out runs/a --threads 2
-  spatter run study.toml --out runs/a --resume   # continue after Ctrl-C
+  spatter run study.toml --out runs/a --resume   # continue after Ctrl-C, SIGTERM or a kill
+  spatter run study.toml --out runs/a --overwrite # replace an earlier run's files
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
   spatter bench dem                              # throughput of an engine
@@ -47,8 +48,23 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
         /// Continue from the checkpoint in the output folder.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "overwrite")]
         resume: bool,
+        /// Delete the files of an earlier run in the output folder before starting.
+        #[arg(long)]
+        overwrite: bool,
+        /// Wall-clock seconds between periodic checkpoints (a kill loses at most this much work).
+        #[arg(long, default_value_t = spatter_scenario::job::DEFAULT_CHECKPOINT_INTERVAL_S)]
+        checkpoint_interval_s: f64,
+        /// More messages on the terminal (-v information, -vv debug); `RUST_LOG` filters the log file.
+        #[arg(short, long, action = clap::ArgAction::Count, conflicts_with = "quiet")]
+        verbose: u8,
+        /// Errors only on the terminal, no progress.
+        #[arg(short, long)]
+        quiet: bool,
+        /// A reduced run (a few steps, parcels or impacts) that exercises every output in seconds.
+        #[arg(long)]
+        smoke: bool,
     },
     /// Validate a scenario and print the fully resolved input (defaults filled in).
     #[command(after_help = "Example:\n  spatter check examples/snow_regime_map.toml")]
@@ -169,8 +185,28 @@ enum SweepAction {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scenario, out, threads, resume } => {
-            commands::run::run_file(&scenario, out.as_deref(), threads, resume)
+        Command::Run {
+            scenario,
+            out,
+            threads,
+            resume,
+            overwrite,
+            checkpoint_interval_s,
+            verbose,
+            quiet,
+            smoke,
+        } => {
+            let args = commands::run::RunArgs {
+                out,
+                threads,
+                resume,
+                overwrite,
+                checkpoint_interval_s,
+                verbose,
+                quiet,
+                smoke,
+            };
+            commands::run::run_file(&scenario, &args)
         }
         Command::Check { scenario } => commands::check(&scenario),
         Command::Demo { out, threads } => commands::run::demo(&out, threads),

@@ -4,7 +4,8 @@
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
-//! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
+//! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
+//! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
 //! * [`plot`] — PNG/SVG charts and mesh colour maps;
 //! * [`summary`] — `summary.json`, a run's result in machine-readable form;
 //! * [`report`] — self-contained HTML reports of runs and studies.
@@ -15,6 +16,7 @@ pub mod plot;
 pub mod pvd;
 pub mod report;
 pub mod run;
+pub mod runlog;
 pub mod summary;
 pub mod vtu;
 

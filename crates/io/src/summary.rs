@@ -24,10 +24,13 @@ pub struct SummaryFile {
     pub headline: Vec<String>,
     /// Labelled output files, relative to the run folder where they are inside it.
     pub artifacts: Vec<(String, PathBuf)>,
-    /// Wall time of this invocation \[s\] (a resumed run counts only its last part).
+    /// Wall time of the run \[s\], summed over the sessions of a stopped and resumed run.
     pub wall_time_s: f64,
     /// Worker threads used.
     pub threads: usize,
+    /// The warnings among the closing lines.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl SummaryFile {
@@ -51,6 +54,7 @@ impl SummaryFile {
                 .collect(),
             wall_time_s,
             threads,
+            warnings: s.headline.iter().filter(|l| l.starts_with("warning")).cloned().collect(),
         }
     }
 

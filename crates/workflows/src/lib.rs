@@ -1,4 +1,6 @@
 //! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
 
+pub mod dem_scene;
 pub mod deposition;
 pub mod snow;
+pub mod sph_scene;

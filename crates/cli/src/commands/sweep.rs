@@ -1,10 +1,9 @@
 //! `spatter sweep STUDY` and `spatter sweep collect STUDY`: parameter studies (crate `spatter-study`).
 
 use super::{report_errors, EXIT_BAD_INPUT};
-use crate::control::{install_ctrlc, CliControl};
+use crate::control::{install_signal_handler, CliControl};
 use anyhow::{Context, Result};
 use spatter_core::control::RunControl;
-use spatter_io::run::RunDir;
 use spatter_study::{CaseRunner, Plan, StudyFile, SweepOptions};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -38,7 +37,8 @@ fn plan(study_path: &Path, out: &Path) -> Result<(StudyFile, Plan), ExitCode> {
     Ok((study, plan))
 }
 
-/// Runs every case in-process, one after another, each in its folder with its own log.
+/// Runs every case in-process, one after another, each through the job driver in its folder with its
+/// own log (the study's log is open again between cases).
 struct InProcess<'a> {
     control: &'a CliControl,
 }
@@ -47,10 +47,15 @@ impl CaseRunner for InProcess<'_> {
     fn run_case(&self, scenario: &Path, dir: &Path, resume: bool) -> Result<(), String> {
         let loaded = spatter_scenario::load(scenario)
             .map_err(|errors| errors.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n"))?;
-        let dir = RunDir::create(dir).map_err(|e| e.to_string())?;
-        let resolved = loaded.scenario.resolved_toml().map_err(|e| e.to_string())?;
-        dir.write_text("run.toml", &resolved).map_err(|e| e.to_string())?;
-        super::run::run_in_dir(&loaded, &dir, self.control, resume).map(|_| ()).map_err(|e| format!("{e:#}"))
+        // A case without a checkpoint starts afresh: the files of an earlier, failed attempt go; the
+        // study's case.toml stays.
+        let opts = spatter_scenario::job::JobOptions {
+            resume,
+            overwrite: !resume,
+            keep: vec!["case.toml".into()],
+            ..spatter_scenario::job::JobOptions::new(dir)
+        };
+        spatter_scenario::job::run(&loaded, &opts, self.control).map(|_| ()).map_err(|e| e.to_string())
     }
 
     fn stop_requested(&self) -> bool {
@@ -72,9 +77,14 @@ pub fn sweep(
         Err(code) => return Ok(code),
     };
     super::run::set_threads(threads)?;
-    install_ctrlc();
-    let control = CliControl::new();
-    crate::logging::init(Some(&out_log(&out)?), control.bar())?;
+    install_signal_handler();
+    let control = CliControl::new(false);
+    if let Some(note) = crate::logging::init(control.bar(), 0, false) {
+        eprintln!("note: {note}");
+    }
+    let log = out_log(&out)?;
+    spatter_io::runlog::open(&log, log.is_file())
+        .with_context(|| format!("cannot open {}", log.display()))?;
     let cases = match shard {
         Some((i, n)) => plan.shard(i, n).count(),
         None => plan.cases.len(),
