@@ -76,6 +76,8 @@ kinds! {
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
     "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run),
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
+    "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run),
+        "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
     "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
@@ -127,7 +129,13 @@ fn load_source(source: Source) -> Result<Loaded, Vec<ScenarioError>> {
                 &source,
                 0,
                 Some("kind".into()),
-                format!("missing key `kind` at the top of the file; expected {}", expected()),
+                if table.contains_key("base") && table.contains_key("vary") {
+                    "this is a parameter study (it has `base` and `[[vary]]`), not a scenario: run it with \
+                     `spatter sweep FILE`"
+                        .to_owned()
+                } else {
+                    format!("missing key `kind` at the top of the file; expected {}", expected())
+                },
             )])
         }
     };

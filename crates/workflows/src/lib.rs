@@ -1,6 +1,8 @@
-//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes, brownout.
+//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes, flow scenes,
+//! brownout.
 
 pub mod brownout;
+pub mod cfd;
 pub mod dem_scene;
 pub mod deposition;
 pub mod snow;
