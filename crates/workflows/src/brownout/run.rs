@@ -42,8 +42,6 @@ pub enum BrownoutError {
     Io(#[from] std::io::Error),
     #[error("checkpoint: {0}")]
     Checkpoint(String),
-    #[error("cannot resume: {0}")]
-    Resume(String),
     #[error("invalid brownout configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
     Invalid(Vec<Invalid>),
 }
@@ -51,7 +49,6 @@ pub enum BrownoutError {
 /// What `checkpoint.bin` holds.
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
-    config: String,
     state: TrackerState,
     source: DustSource,
     next_output: u64,
@@ -72,7 +69,6 @@ fn balance_row(t: f64, b: &CloudBalance, airborne: usize) -> [f64; 7] {
 /// Runs a brownout scenario.
 pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, BrownoutError> {
     Checker::run(cfg, None).map_err(BrownoutError::Invalid)?;
-    let config = serde_json::to_string(cfg).unwrap_or_default();
     let air = cfg.air;
     let rotor = cfg.rotor.downwash(&air);
     let r0 = rotor.radius_m;
@@ -251,13 +247,8 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
     let ckpt = ctx.dir.checkpoint_path();
     let mut next_output = 0u64;
     let (mut bal_csv, mut opt_csv, mut pvd) = if ctx.resume && ckpt.is_file() {
+        // The checkpoint's header carries the input hash: another scenario's checkpoint is refused here.
         let c: Checkpoint = ctx.load_checkpoint().map_err(|e| BrownoutError::Checkpoint(e.to_string()))?;
-        if c.config != config {
-            return Err(BrownoutError::Resume(format!(
-                "{} was written by a different configuration; start afresh without --resume",
-                ckpt.display()
-            )));
-        }
         sim.tracker.state = c.state;
         sim.source = c.source;
         next_output = c.next_output;
@@ -307,7 +298,6 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
             bal_csv.flush()?;
             opt_csv.flush()?;
             let c = Checkpoint {
-                config: config.clone(),
                 state: sim.tracker.state.clone(),
                 source: sim.source.clone(),
                 next_output,

@@ -192,12 +192,11 @@ fn a_stopped_and_resumed_run_writes_the_same_files() {
         compared += 1;
     }
     assert_eq!(compared, 9);
-    // A different configuration is refused.
+    // Another scenario's checkpoint (another input hash) is refused.
     let c = RunDir::create(&root.path().join("c")).unwrap();
     let stop = StopAfterPolls::new(5);
     assert_eq!(run(&cfg, &RunContext::new(&c, &stop, false)).unwrap().finished, Finished::Interrupted);
-    let mut other = cfg.clone();
-    other.cloud.seed = 9;
-    let e = run(&other, &RunContext::new(&c, &Unattended, true)).unwrap_err();
-    assert!(e.to_string().contains("different configuration"), "{e}");
+    let ctx = RunContext { input_hash: 12, ..RunContext::new(&c, &Unattended, true) };
+    let e = run(&cfg, &ctx).unwrap_err().to_string();
+    assert!(e.contains("checkpoint.bin") && e.contains("different scenario"), "{e}");
 }
