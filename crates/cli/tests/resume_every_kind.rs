@@ -378,3 +378,16 @@ fn absurd_thread_counts_are_refused() {
         assert!(t.contains(&format!("--threads {n}")) && !t.contains("panicked"), "{t}");
     }
 }
+
+#[test]
+fn brownout_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = include_str!("../../../examples/brownout_bell47.toml")
+        .replace("duration_s = 6.0", "duration_s = 0.06")
+        .replace("interval_s = 0.25", "interval_s = 0.02")
+        .replace("grid_cells = [48, 48, 16]", "grid_cells = [8, 8, 4]")
+        .replace("classes = 10", "classes = 4")
+        .replace("[liftoff]", "[liftoff]\npoints = 8");
+    let s = write(dir.path(), "brownout.toml", text.as_bytes());
+    stop_and_resume(&s, 12, "brownout");
+}

@@ -6,7 +6,13 @@
 //! uniformly random points; forces are Schiller–Naumann drag and gravity; Δt = 1 ms (a parcel moves
 //! about a quarter of a cell per step). The benchmark runs with 1 and 2 threads and also times the
 //! point location alone (the same positions and hints the next step starts from).
+//!
+//! The rotor case ([`rotor_bench`]) tracks sand parcels in the analytic rotor downwash of the Bell 47 at
+//! z_d/R = 0.68 (Jasion 2013 Ch. 6) with the mean flow alone, with the tabulated tip vortices and with
+//! the directly summed tip vortices, one worker thread, and prints parcel-steps per CPU-second of each.
 
+use crate::field::analytic::{AnalyticField, AnalyticSet};
+use crate::field::rotor::RotorDownwash;
 use crate::field::tetmesh::{kuhn_box, TetMesh};
 use crate::field::{FieldError, ImportOptions, ImportedField};
 use crate::forces::model::{ForceModel, ForceSwitches};
@@ -16,7 +22,7 @@ use crate::tracker::{Parcel, TrackSettings, Tracker, CHUNK};
 use crate::vtk::{cell_type, DataArray, VtkDataset};
 use rayon::prelude::*;
 use spatter_core::rng::{seeded, RngExt};
-use spatter_core::Vec3;
+use spatter_core::{Aabb, Vec3};
 use std::time::Instant;
 
 fn cellular(p: Vec3) -> Vec3 {
@@ -55,8 +61,9 @@ fn mesh_bytes(m: &TetMesh) -> usize {
     m.points.len() * 24 + m.tets.len() * (16 + 16 + 4)
 }
 
-/// Runs the benchmark and returns the printable lines. `quick`: 10⁵ parcels in about 10⁵ tetrahedra.
-pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
+/// Runs the unstructured-field benchmark and returns the printable lines. `quick`: 10⁵ parcels in about
+/// 10⁵ tetrahedra.
+pub fn unstructured_bench(quick: bool) -> Result<Vec<String>, FieldError> {
     let (n_mesh, n_parcels, steps) = if quick { (25, 100_000, 3) } else { (55, 1_000_000, 5) };
     let t0 = Instant::now();
     let field = bench_field(n_mesh)?;
@@ -160,12 +167,116 @@ pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
     Ok(lines)
 }
 
+/// [`unstructured_bench`] followed by [`rotor_bench`] (`spatter bench track`).
+pub fn bench(quick: bool) -> Result<Vec<String>, FieldError> {
+    let mut lines = unstructured_bench(quick)?;
+    lines.extend(rotor_bench(quick)?);
+    Ok(lines)
+}
+
+/// Parcel-steps per CPU-second (one worker thread) of `steps` steps of the parcels `starts` in `rotor`,
+/// and the wall time of the first step (which builds the tip-vortex table when there is one).
+fn rotor_rate(rotor: &RotorDownwash, starts: &[Vec3], steps: usize) -> Result<(f64, f64), FieldError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| FieldError::Config(e.to_string()))?;
+    let field = AnalyticSet { parts: vec![AnalyticField::Rotor(rotor.clone())], turbulence: None };
+    Ok(pool.install(|| {
+        let model = ForceModel::new(
+            crate::forces::Fluid { density: rotor.air_density_kg_m3, viscosity: 1.82e-5 },
+            ForceSwitches::default(),
+        );
+        let r = rotor.radius_m;
+        let domain =
+            Aabb::new(Vec3::new(-6.0 * r, -6.0 * r, rotor.ground_z_m), Vec3::new(6.0 * r, 6.0 * r, 3.0 * r));
+        let settings = TrackSettings {
+            dt: 1e-3,
+            domain: Some(domain),
+            dispersion: None,
+            max_bounces: 8,
+            resort_interval: 0,
+        };
+        let t = Instant::now();
+        let _ = rotor.tabulated_vortices();
+        let setup = t.elapsed().as_secs_f64();
+        let mut tr = Tracker::new(&field, model, settings, vec![]);
+        for &x in starts {
+            tr.add(
+                NewParcel {
+                    pos: x,
+                    vel: field.velocity(x, 0.0),
+                    diameter: 20e-6,
+                    density: 2480.0,
+                    count: 1.0,
+                },
+                0,
+            );
+        }
+        let cpu0 = thread_cpu_ns();
+        let t = Instant::now();
+        let mut parcel_steps = 0usize;
+        for _ in 0..steps {
+            parcel_steps += tr.airborne();
+            let _ = tr.step();
+        }
+        let wall = t.elapsed().as_secs_f64();
+        let secs = match (cpu0, thread_cpu_ns()) {
+            (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+            _ => wall,
+        };
+        (parcel_steps as f64 / secs.max(1e-12), setup)
+    }))
+}
+
+/// The rotor benchmark: 20 µm sand parcels (2480 kg/m³) spread over 0.3 < r/R < 2.5 and 0 < z < z_hub
+/// under the Bell 47 at z_d/R = 0.68 (T = 8.8 kN, R = 5.66 m, Ω = 35.6 rad/s, 10 revolutions of tip
+/// vortices), Schiller–Naumann drag and gravity, Δt = 1 ms, one thread. `quick`: fewer parcels and steps.
+pub fn rotor_bench(quick: bool) -> Result<Vec<String>, FieldError> {
+    let (n, steps, n_direct, steps_direct) = if quick { (2000, 5, 200, 2) } else { (20_000, 20, 1000, 3) };
+    let mut rotor = RotorDownwash::bell47(0.68);
+    let mut rng = seeded(2025, 1);
+    let r0 = rotor.radius_m;
+    let starts: Vec<Vec3> = (0..n)
+        .map(|_| {
+            let r = r0 * (0.3 + 2.2 * rng.random::<f64>());
+            let a = std::f64::consts::TAU * rng.random::<f64>();
+            Vec3::new(r * a.cos(), r * a.sin(), 0.01 + (rotor.hub_m.z - 0.01) * rng.random::<f64>())
+        })
+        .collect();
+    let (mean, _) = rotor_rate(&rotor, &starts, steps)?;
+    rotor.tip_vortices = true;
+    let (table, build) = rotor_rate(&rotor, &starts, steps)?;
+    let nodes = rotor.tabulated_vortices().map(|t| (t.nodes(), t.bytes())).unwrap_or((0, 0));
+    rotor.vortex_table = false;
+    let (direct, _) = rotor_rate(&rotor, &starts[..n_direct], steps_direct)?;
+    Ok(vec![
+        format!(
+            "track rotor: Bell 47 at z_d/R = 0.68, {n} parcels of 20 µm sand, dt = 1 ms, 1 thread, parcel-steps per CPU-second:"
+        ),
+        format!(
+            "track rotor: mean flow {mean:.3e}; tip vortices tabulated {table:.3e} ({:.2}× the cost of the mean flow; table {} nodes, {:.1} MB, built in {build:.2} s); tip vortices summed directly {direct:.3e} ({:.0}×)",
+            mean / table,
+            nodes.0,
+            nodes.1 as f64 / 1e6,
+            mean / direct
+        ),
+    ])
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
     fn quick_bench_runs() {
-        let lines = super::bench(true).unwrap();
+        let lines = super::unstructured_bench(true).unwrap();
         assert_eq!(lines.len(), 4, "{lines:?}");
         assert!(lines[1].contains("parcel-steps/s"));
+    }
+
+    #[test]
+    fn quick_rotor_bench_runs() {
+        let lines = super::rotor_bench(true).unwrap();
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(lines[1].contains("tabulated"));
     }
 }

@@ -13,6 +13,7 @@ use std::path::Path;
 
 const VTK_VERTEX: u8 = 1;
 const VTK_TRIANGLE: u8 = 5;
+const VTK_HEXAHEDRON: u8 = 12;
 
 /// Builder for one `.vtu` file.
 #[derive(Clone, Debug)]
@@ -50,6 +51,49 @@ impl Vtu {
             connectivity: triangles.iter().flat_map(|t| t.map(i64::from)).collect(),
             offsets: (1..=triangles.len() as i64).map(|k| 3 * k).collect(),
             types: vec![VTK_TRIANGLE; triangles.len()],
+            point_data: Vec::new(),
+            cell_data: Vec::new(),
+        }
+    }
+
+    /// A box of `dims` = \[n_x, n_y, n_z\] hexahedral cells of size `spacing` from the corner `origin`
+    /// (a uniform grid written as an unstructured one). Cells are numbered x fastest, then y, then z, so
+    /// cell data index i + n_x (j + n_y k).
+    pub fn hexahedral_grid(origin: Vec3, spacing: Vec3, dims: [usize; 3]) -> Self {
+        let [nx, ny, nz] = dims;
+        let mut points = Vec::with_capacity(3 * (nx + 1) * (ny + 1) * (nz + 1));
+        for k in 0..=nz {
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    let p = origin + spacing * Vec3::new(i as f64, j as f64, k as f64);
+                    points.extend_from_slice(&p.to_array());
+                }
+            }
+        }
+        let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as i64;
+        let n = nx * ny * nz;
+        let mut connectivity = Vec::with_capacity(8 * n);
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    connectivity.extend_from_slice(&[
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1),
+                    ]);
+                }
+            }
+        }
+        Vtu {
+            points,
+            connectivity,
+            offsets: (1..=n as i64).map(|c| 8 * c).collect(),
+            types: vec![VTK_HEXAHEDRON; n],
             point_data: Vec::new(),
             cell_data: Vec::new(),
         }
@@ -252,6 +296,21 @@ pub fn read(path: &Path) -> io::Result<VtuData> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hexahedral_grid_round_trips() {
+        let g = Vtu::hexahedral_grid(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 1.0, 2.0), [2, 3, 1])
+            .cell_scalar("c", &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.vtu");
+        g.write(&path).unwrap();
+        let back = read(&path).unwrap();
+        assert_eq!(back.points.len(), 3 * 4 * 2);
+        assert_eq!(back.points[back.points.len() - 1], Vec3::new(2.0, 5.0, 5.0));
+        assert_eq!(back.connectivity.len(), 6 * 8);
+        // Cell 1 (i = 1, j = 0, k = 0) starts at point 1 and its top face at point 1 + 12.
+        assert_eq!(&back.connectivity[8..16], &[1, 2, 5, 4, 13, 14, 17, 16]);
+    }
 
     #[test]
     fn particles_round_trip_exactly() {

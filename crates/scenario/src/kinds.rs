@@ -80,6 +80,8 @@ kinds! {
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
+    "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
+        "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";
 }
 
 #[allow(dead_code)]

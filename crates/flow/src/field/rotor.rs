@@ -28,11 +28,19 @@
 //! and Lamb–Oseen swirl (eq. 6.14) in the meridional plane about the ring's core (the thesis's 2-D
 //! treatment; the ring's self-induction is neglected), plus its mirror image in the ground.
 
+pub mod rings;
+pub mod special;
+pub mod table;
+
 use super::analytic::LAMB_OSEEN_ALPHA;
+pub use rings::{ring_stream_function, ring_velocity, VortexPath};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::Vec3;
+pub use special::elliptic_ke;
 use std::f64::consts::PI;
+use std::sync::{Arc, OnceLock};
+pub use table::VortexTable;
 
 /// Rotor model parameters. Scenario table `{ kind = "rotor", … }`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,6 +95,35 @@ pub struct RotorDownwash {
     /// Vortices older than this many revolutions are dropped.
     #[serde(default = "default_age")]
     pub vortex_max_age_revs: f64,
+    /// Evaluate the tip vortices from a precomputed table plus the exact rings near the point
+    /// ([`table`]); `false` sums every ring directly (same field within [`table::TABLE_TOLERANCE`],
+    /// slower).
+    #[serde(default = "yes")]
+    pub vortex_table: bool,
+    /// The table, built on first use (not part of the configuration).
+    #[serde(skip)]
+    pub vortex_cache: VortexCache,
+}
+
+/// Lazily built [`VortexTable`] of a rotor, shared by its clones. Compares equal to any other cache: it
+/// is derived data, not configuration.
+#[derive(Clone, Default)]
+pub struct VortexCache(OnceLock<Option<Arc<VortexTable>>>);
+
+impl PartialEq for VortexCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for VortexCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0.get() {
+            Some(Some(t)) => write!(f, "VortexCache({} nodes)", t.nodes()),
+            Some(None) => write!(f, "VortexCache(direct)"),
+            None => write!(f, "VortexCache(not built)"),
+        }
+    }
 }
 
 fn default_rho() -> f64 {
@@ -199,6 +236,43 @@ fn smooth_min1(s: f64, k: f64) -> f64 {
 }
 
 impl RotorDownwash {
+    /// A rotor with hub `hub_m`, radius, thrust and speed, every other key at its default.
+    pub fn new(hub_m: Vec3, radius_m: f64, thrust_n: f64, omega_rad_s: f64) -> Self {
+        RotorDownwash {
+            hub_m,
+            radius_m,
+            thrust_n,
+            air_density_kg_m3: default_rho(),
+            kinematic_viscosity_m2_s: default_nu(),
+            blades: default_blades(),
+            omega_rad_s,
+            ground_z_m: 0.0,
+            ground: true,
+            ground_layer_thickness: default_layer(),
+            ground_layer_spreading: default_spreading(),
+            shear_layer_sharpness: default_sharpness(),
+            tip_vortices: false,
+            core_radius_fraction: default_core(),
+            squire_a1: default_a1(),
+            vortex_path_height: default_path(),
+            vortex_speed_fraction: default_speed(),
+            vortex_max_age_revs: default_age(),
+            vortex_table: true,
+            vortex_cache: VortexCache::default(),
+        }
+    }
+
+    /// The Bell 47 (H-13) in hover of Jasion (2013) Ch. 6 at hub height `z_d_over_r`·R above the ground
+    /// at z = 0: R = 5.66 m, T = W = 8.8 kN, Ω = 35.6 rad/s, two blades, air ρ = 1.19 kg/m³,
+    /// μ = 1.82 × 10⁻⁵ Pa s (Table 6.1); tip vortices off.
+    pub fn bell47(z_d_over_r: f64) -> Self {
+        let radius = 5.66;
+        let mut r = RotorDownwash::new(Vec3::new(0.0, 0.0, z_d_over_r * radius), radius, 8800.0, 35.6);
+        r.air_density_kg_m3 = 1.19;
+        r.kinematic_viscosity_m2_s = 1.82e-5 / 1.19;
+        r
+    }
+
     pub fn induced_velocity(&self) -> f64 {
         induced_velocity(self.thrust_n, self.air_density_kg_m3, self.radius_m)
     }
@@ -247,58 +321,66 @@ impl RotorDownwash {
         self.velocity_rz(r, z, |r, z| self.stream_function(r, z))
     }
 
-    /// Position (r_v, z_v) of a vortex ring of age `age` \[s\] along its path.
-    pub fn vortex_position(&self, age: f64) -> (f64, f64) {
-        let s = self.vortex_speed_fraction * self.induced_velocity() * age;
-        let z_path = self.ground_z_m + self.vortex_path_height * self.radius_m;
-        let leg = if self.ground { (self.hub_m.z - z_path).max(0.0) } else { f64::INFINITY };
-        if s < leg {
-            (self.slipstream_radius(s), self.hub_m.z - s)
-        } else {
-            (self.slipstream_radius(leg) + (s - leg), z_path)
-        }
+    /// The tip-vortex system (path, core growth, circulation) with its constants precomputed.
+    pub fn vortex_path(&self) -> VortexPath {
+        VortexPath::new(self)
     }
 
-    /// (circulation, core radius) of a ring of age `age` at radius `r_v`.
+    /// Position (r_v, z_v) of a vortex ring of age `age` \[s\] along its path.
+    pub fn vortex_position(&self, age: f64) -> (f64, f64) {
+        self.vortex_path().position(age)
+    }
+
+    /// Core radius \[m\] of a ring of age `age` at radius `r_v` (eq. 6.13).
     pub fn vortex_core(&self, age: f64, r_v: f64) -> f64 {
-        let gamma = self.circulation();
-        let nu = self.kinematic_viscosity_m2_s;
-        let dv = squire_delta(self.squire_a1, gamma, nu);
-        let strain = (r_v - self.radius_m) / self.radius_m;
-        core_radius(
-            self.core_radius_fraction * self.radius_m,
-            dv,
-            nu,
-            self.omega_rad_s * age,
-            self.omega_rad_s,
-            strain,
-        )
+        self.vortex_path().core(age, r_v)
     }
 
     /// Stokes stream function of the rings alive at time `t` and their ground images \[m³/s\].
     pub fn vortex_stream_function(&self, r: f64, z: f64, t: f64) -> f64 {
-        let gamma = self.circulation();
-        let period = 2.0 * PI / (self.blades as f64 * self.omega_rad_s);
-        let max_age = self.vortex_max_age_revs * 2.0 * PI / self.omega_rad_s;
-        let newest = (t / period).floor();
+        let path = self.vortex_path();
+        let phi = path.phase(t);
         let mut psi = 0.0;
-        let mut j = 0.0;
-        loop {
-            let age = t - (newest - j) * period;
-            if age > max_age {
-                break;
-            }
-            j += 1.0;
-            let (rv, zv) = self.vortex_position(age);
-            let rc = self.vortex_core(age, rv);
+        for j in 0..path.count(phi) {
+            let ring = path.ring(phi + j as f64 * path.period);
             // The tip vortex turns the flow down inboard of its core (it bounds the slipstream): with
             // Lamb's sign convention that is circulation −Γ_v. The ground image has +Γ_v.
-            psi -= ring_stream_function(gamma, rv, zv, rc, r, z);
-            if self.ground {
-                psi += ring_stream_function(gamma, rv, 2.0 * self.ground_z_m - zv, rc, r, z);
+            psi -= ring_stream_function(path.gamma, ring.r, ring.z, ring.rc, r, z);
+            if let Some(zg) = path.ground_z {
+                psi += ring_stream_function(path.gamma, ring.r, 2.0 * zg - ring.z, ring.rc, r, z);
             }
         }
         psi
+    }
+
+    /// The tip-vortex table when it is in use (built on the first call; `None` with `tip_vortices` or
+    /// `vortex_table` off, or when the rotor was changed after the table was built).
+    pub fn tabulated_vortices(&self) -> Option<&VortexTable> {
+        if !(self.tip_vortices && self.vortex_table) {
+            return None;
+        }
+        let table = self
+            .vortex_cache
+            .0
+            .get_or_init(|| {
+                let mut source = self.clone();
+                source.vortex_cache = VortexCache::default();
+                VortexTable::build(&source).map(Arc::new)
+            })
+            .as_deref()?;
+        (table.source == *self).then_some(table)
+    }
+
+    /// Velocity (u_r, u_z) of the tip vortices at (r, z), time `t`: the table with the exact near rings,
+    /// or the direct sum over every ring.
+    pub fn vortex_velocity_rz(&self, r: f64, z: f64, t: f64) -> (f64, f64) {
+        if self.ground && z <= self.ground_z_m {
+            return (0.0, 0.0);
+        }
+        match self.tabulated_vortices() {
+            Some(table) => table.velocity(r, z, t),
+            None => self.vortex_path().velocity_direct(r, z, t),
+        }
     }
 
     /// (u_r, u_z) = (−(1/r)∂ψ/∂z, (1/r)∂ψ/∂r) by central differences of `psi`.
@@ -321,55 +403,15 @@ impl RotorDownwash {
         let d = x - self.hub_m;
         let rho = Vec3::new(d.x, d.y, 0.0);
         let r = rho.length();
-        let (ur, uz) = if self.tip_vortices {
-            self.velocity_rz(r, x.z, |r, z| self.stream_function(r, z) + self.vortex_stream_function(r, z, t))
-        } else {
-            self.mean_velocity_rz(r, x.z)
-        };
+        let (mut ur, mut uz) = self.mean_velocity_rz(r, x.z);
+        if self.tip_vortices {
+            let (a, b) = self.vortex_velocity_rz(r, x.z, t);
+            ur += a;
+            uz += b;
+        }
         let e_r = if r > 0.0 { rho / r } else { Vec3::ZERO };
         ur * e_r + uz * Vec3::Z
     }
-}
-
-/// Complete elliptic integrals K(m) and E(m) of parameter m = k² < 1 by the arithmetic–geometric mean
-/// (Abramowitz & Stegun 17.6).
-pub fn elliptic_ke(m: f64) -> (f64, f64) {
-    let mut a = 1.0;
-    let mut b = (1.0 - m).sqrt();
-    let mut c = m.sqrt();
-    let mut sum = 0.5 * c * c;
-    let mut pow = 0.5;
-    for _ in 0..40 {
-        if c.abs() < 1e-16 {
-            break;
-        }
-        let an = 0.5 * (a + b);
-        let bn = (a * b).sqrt();
-        c = 0.5 * (a - b);
-        a = an;
-        b = bn;
-        pow *= 2.0;
-        sum += pow * c * c;
-    }
-    let k = PI / (2.0 * a);
-    (k, k * (1.0 - sum))
-}
-
-/// Stokes stream function at (r, z) of a vortex ring of circulation Γ, radius r_v at height z_v: the
-/// thin ring of Lamb (1932) §161, ψ = (Γ/2π)√(r r_v)[(2/k − k)K − (2/k)E], k² = 4 r r_v/((r + r_v)² +
-/// (z − z_v)²), multiplied by the Lamb–Oseen core factor 1 − exp(−α d²/r_c²) of the distance d to the
-/// core line so that the velocity stays finite and vanishes there. Any ψ gives a divergence-free flow.
-pub fn ring_stream_function(gamma: f64, rv: f64, zv: f64, rc: f64, r: f64, z: f64) -> f64 {
-    let dz = z - zv;
-    let d2 = (r - rv) * (r - rv) + dz * dz;
-    if d2 <= 0.0 || r <= 0.0 {
-        return 0.0;
-    }
-    let m = (4.0 * r * rv / ((r + rv) * (r + rv) + dz * dz)).min(1.0 - 1e-16);
-    let k = m.sqrt();
-    let (kk, ee) = elliptic_ke(m);
-    let thin = gamma / (2.0 * PI) * (r * rv).sqrt() * ((2.0 / k - k) * kk - 2.0 / k * ee);
-    thin * (1.0 - (-LAMB_OSEEN_ALPHA * d2 / (rc * rc)).exp())
 }
 
 #[cfg(test)]
@@ -378,26 +420,9 @@ mod tests {
     use crate::field::fd_gradient;
 
     fn bell47(ground: bool) -> RotorDownwash {
-        RotorDownwash {
-            hub_m: Vec3::new(0.0, 0.0, 0.68 * 5.66),
-            radius_m: 5.66,
-            thrust_n: 8800.0,
-            air_density_kg_m3: 1.19,
-            kinematic_viscosity_m2_s: 1.82e-5 / 1.19,
-            blades: 2,
-            omega_rad_s: 35.6,
-            ground_z_m: 0.0,
-            ground,
-            ground_layer_thickness: 0.15,
-            ground_layer_spreading: 0.09,
-            shear_layer_sharpness: 20.0,
-            tip_vortices: false,
-            core_radius_fraction: 0.03,
-            squire_a1: 2e-4,
-            vortex_path_height: 0.25,
-            vortex_speed_fraction: 0.5,
-            vortex_max_age_revs: 10.0,
-        }
+        let mut r = RotorDownwash::bell47(0.68);
+        r.ground = ground;
+        r
     }
 
     #[test]
@@ -473,20 +498,6 @@ mod tests {
     }
 
     #[test]
-    fn elliptic_integrals_and_ring_velocity() {
-        // A&S Table 17.1: K(0.5) = 1.8540746773, E(0.5) = 1.3506438810.
-        let (k, e) = elliptic_ke(0.5);
-        assert!((k - 1.8540746773).abs() < 1e-10 && (e - 1.3506438810).abs() < 1e-10);
-        // A thin ring's speed on its axis is Γ r_v²/(2 (r_v² + z²)^(3/2)) (Lamb §161).
-        let (g, rv) = (2.0, 1.0);
-        let h = 1e-4;
-        let z = 0.7;
-        let uz_axis = 2.0 * ring_stream_function(g, rv, 0.0, 1e-3, h, z) / (h * h);
-        let expect = g * rv * rv / (2.0 * (rv * rv + z * z).powf(1.5));
-        assert!((uz_axis.abs() - expect).abs() < 1e-4 * expect, "{uz_axis} vs {expect}");
-    }
-
-    #[test]
     fn tip_vortex_turns_down_inboard_of_its_core() {
         // A ring just born at the tip: inboard of its core the flow goes down (it bounds the wake).
         let r = bell47(true);
@@ -507,5 +518,29 @@ mod tests {
         assert!((rv - 5.66).abs() < 1e-12 && (zv - r.hub_m.z).abs() < 1e-12);
         let (rv, zv) = r.vortex_position(10.0);
         assert!((zv - 0.25 * 5.66).abs() < 1e-12 && rv > 5.66);
+    }
+
+    #[test]
+    fn vortex_velocity_is_the_curl_of_the_vortex_stream_function() {
+        // The closed-form ring velocities summed over every ring equal the central differences of the
+        // summed stream function: u_r = −(1/r)∂ψ/∂z, u_z = (1/r)∂ψ/∂r.
+        let mut r = bell47(true);
+        r.tip_vortices = true;
+        r.vortex_table = false;
+        let t = 0.731;
+        for (x, z) in [(3.0, 1.0), (6.5, 1.5), (8.0, 0.3), (5.0, 3.5), (12.0, 2.0)] {
+            let h = 1e-6 * r.radius_m;
+            let psi = |a: f64, b: f64| r.vortex_stream_function(a, b, t);
+            let ur = -(psi(x, z + h) - psi(x, z - h)) / (2.0 * h) / x;
+            let uz = (psi(x + h, z) - psi(x - h, z)) / (2.0 * h) / x;
+            let path = r.vortex_path();
+            let phi = path.phase(t);
+            let (a, b) = path.velocity_rings(phi, path.count(phi), x, z, |ring| ring.rc);
+            let scale = a.abs() + b.abs() + 1e-2;
+            assert!(
+                (a - ur).abs() < 1e-5 * scale && (b - uz).abs() < 1e-5 * scale,
+                "({x}, {z}): {a} {b} vs {ur} {uz}"
+            );
+        }
     }
 }

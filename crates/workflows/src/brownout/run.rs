@@ -1,0 +1,394 @@
+//! Running a `brownout` scenario.
+//!
+//! Outputs in the run folder:
+//!
+//! * `liftoff_map.csv`, `liftoff_map.png`, `liftoff_thresholds.png` — the lift-off analysis on the mean
+//!   flow (ground distance × grain size; thresholds against size);
+//! * `entrainment_source.csv` — the source's mass rate per annulus and size class;
+//! * `cloud_balance.csv` — every `output.interval_s`: entrained, airborne, redeposited and left mass;
+//! * `entrained_mass.png` — those curves;
+//! * `cloud.pvd` + `cloud/cloud_NNNNN.vtu` — mass concentration and extinction on the grid;
+//! * `optical_depth.csv`, `optical_depth.png` — optical depth of every line of sight against time.
+//!
+//! Stopping (Ctrl-C, SIGTERM) writes `checkpoint.bin` after a whole step; `--resume` continues and gives
+//! the same files as an uninterrupted run.
+
+use super::config::BrownoutConfig;
+use serde::{Deserialize, Serialize};
+use spatter_core::check::{Checker, Invalid};
+use spatter_core::control::Finished;
+use spatter_core::Vec3;
+use spatter_flow::cloud::grid::CloudGrid;
+use spatter_flow::cloud::sim::{CloudBalance, CloudSim};
+use spatter_flow::cloud::source::{entrainment_rates, DustSource};
+use spatter_flow::cloud::LARGE_PARTICLE_EXTINCTION;
+use spatter_flow::field::analytic::{AnalyticField, AnalyticSet};
+use spatter_flow::field::rotor::RotorDownwash;
+use spatter_flow::forces::model::{ForceModel, ForceSwitches};
+use spatter_flow::liftoff::ground_shear::{ground_shear, GroundProbe, GroundShear, ShearMethod};
+use spatter_flow::liftoff::map::lift_off_map;
+use spatter_flow::tracker::{TrackError, TrackSettings, TrackerState};
+use spatter_io::csv::CsvSeries;
+use spatter_io::plot::Chart;
+use spatter_io::pvd::PvdSeries;
+use spatter_io::run::{RunContext, RunSummary};
+
+/// Why a brownout run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BrownoutError {
+    #[error(transparent)]
+    Track(#[from] TrackError),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("checkpoint: {0}")]
+    Checkpoint(String),
+    #[error("invalid brownout configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
+    Invalid(Vec<Invalid>),
+}
+
+/// What `checkpoint.bin` holds.
+#[derive(Serialize, Deserialize)]
+struct Checkpoint {
+    state: TrackerState,
+    source: DustSource,
+    next_output: u64,
+    balance_bytes: u64,
+    optics_bytes: u64,
+}
+
+/// Most parcels a run may release (about 1 GB of parcel state).
+const MAX_PARCELS: f64 = 1e7;
+
+const BALANCE_COLUMNS: [&str; 7] =
+    ["time_s", "entrained_kg", "airborne_kg", "redeposited_kg", "left_kg", "pending_kg", "airborne_parcels"];
+
+fn balance_row(t: f64, b: &CloudBalance, airborne: usize) -> [f64; 7] {
+    [t, b.entrained, b.airborne, b.redeposited, b.left, b.pending, airborne as f64]
+}
+
+/// Runs a brownout scenario.
+pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, BrownoutError> {
+    Checker::run(cfg, None).map_err(BrownoutError::Invalid)?;
+    let air = cfg.air;
+    let rotor = cfg.rotor.downwash(&air);
+    let r0 = rotor.radius_m;
+    let g = 9.81;
+    let rho_p = cfg.ground.density_kg_m3;
+    let classes = cfg
+        .ground
+        .size
+        .classes()
+        .map_err(|e| BrownoutError::Invalid(vec![Invalid { key: "ground.size".into(), message: e }]))?;
+    let field = AnalyticSet { parts: vec![AnalyticField::Rotor(rotor.clone())], turbulence: None };
+    // The mean flow (the tip vortices are a fluctuation about it): the lift-off map's field, with the
+    // gust factor standing for the fluctuations as in the thesis's mean + 2u′.
+    let mean_rotor = RotorDownwash { tip_vortices: false, ..rotor.clone() };
+    let mean_field = AnalyticSet { parts: vec![AnalyticField::Rotor(mean_rotor)], turbulence: None };
+    let mut summary = RunSummary::new(Finished::Completed);
+
+    // 1. Lift-off map on the mean flow.
+    let lo = &cfg.liftoff;
+    let n = lo.points;
+    let probe = GroundProbe {
+        origin: Vec3::ZERO,
+        direction: Vec3::X,
+        distances: (0..n)
+            .map(|i| {
+                r0 * (lo.radius_min_over_radius
+                    + (lo.radius_max_over_radius - lo.radius_min_over_radius) * i as f64 / (n - 1) as f64)
+            })
+            .collect(),
+        method: ShearMethod::JetPeak { max_height: lo.shear_max_height_over_radius * r0, samples: 96 },
+        gust: lo.gust_factor,
+    };
+    let map = lift_off_map(&mean_field, &probe, r0, (&lo.diameters_m, rho_p), &air, &cfg.rocking(), 0.0);
+    let title = format!(
+        "lift-off map: rotor R = {r0} m at z_d/R = {}, gust factor {}",
+        cfg.rotor.height_over_radius, lo.gust_factor
+    );
+    for (name, label) in [
+        ("liftoff_map.csv", "lift-off map table"),
+        ("liftoff_map.png", "lift-off map"),
+        ("liftoff_thresholds.png", "lift-off thresholds"),
+    ] {
+        let path = ctx.dir.path(name);
+        match name {
+            "liftoff_map.csv" => map.write_csv(&path)?,
+            "liftoff_map.png" => map.write_png(&path, &title)?,
+            _ => map.write_threshold_png(&path, "friction velocity to rock and to lift off a grain")?,
+        }
+        summary.artifacts.push((label.into(), path));
+    }
+    let u_max = map.ground.iter().map(|g| g.u_star).fold(0.0, f64::max);
+    summary.scalar("max_friction_velocity_m_s", u_max);
+    // Which size lifts off most easily (largest lift ratio anywhere).
+    let (k_best, (ratio_best, at_best)) = (0..map.diameters.len())
+        .map(|k| (k, map.peak_lift(k)))
+        .fold((0, (f64::NEG_INFINITY, 0.0)), |a, b| if b.1 .0 > a.1 .0 { b } else { a });
+    summary.headline.push(format!(
+        "lift-off: friction velocity up to {u_max:.3} m/s; the largest lift / (weight + cohesion) is {ratio_best:.3} for {:.0} µm grains at r/R = {:.2}",
+        map.diameters[k_best] * 1e6,
+        at_best / r0
+    ));
+    summary.scalar("most_liftable_diameter_um", map.diameters[k_best] * 1e6);
+
+    // 2. The entrainment source on annuli.
+    let en = &cfg.entrainment;
+    let edges: Vec<f64> = (0..=en.annuli)
+        .map(|i| {
+            r0 * (en.radius_min_over_radius
+                + (en.radius_max_over_radius - en.radius_min_over_radius) * i as f64 / en.annuli as f64)
+        })
+        .collect();
+    let mids: Vec<f64> = edges.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let src_probe = GroundProbe { distances: mids.clone(), gust: en.gust_factor, ..probe.clone() };
+    let ref_probe = GroundProbe {
+        method: ShearMethod::FixedHeight { height: en.reference_height_m },
+        ..src_probe.clone()
+    };
+    // With tip vortices the flux (nonlinear in u_*) is averaged over one shedding period, sampled at
+    // `phases` equally spaced times; the mean flow is steady and needs one sample.
+    let phases = if rotor.tip_vortices { en.phases } else { 1 };
+    let period = std::f64::consts::TAU / (rotor.blades as f64 * rotor.omega_rad_s);
+    let mut ground: Vec<GroundShear> = Vec::new();
+    let mut rates: Vec<Vec<f64>> = Vec::new();
+    for k in 0..phases {
+        let t = period * k as f64 / phases as f64;
+        let gs = ground_shear(&field, &src_probe, t, &air);
+        let reference: Vec<f64> = ground_shear(&field, &ref_probe, t, &air).iter().map(|g| g.speed).collect();
+        let r = entrainment_rates(
+            &edges,
+            &gs,
+            &reference,
+            &classes,
+            &en.model,
+            &en.threshold.threshold(),
+            (rho_p, air.density, g),
+        );
+        if k == 0 {
+            ground = gs;
+            rates = r;
+        } else {
+            for (a, row) in rates.iter_mut().enumerate() {
+                for (c, v) in row.iter_mut().enumerate() {
+                    *v += r[a][c];
+                }
+                ground[a].u_star += gs[a].u_star;
+            }
+        }
+    }
+    for (a, row) in rates.iter_mut().enumerate() {
+        for v in row.iter_mut() {
+            *v /= phases as f64;
+        }
+        ground[a].u_star /= phases as f64;
+    }
+    {
+        let mut rows = Vec::new();
+        for (a, row) in rates.iter().enumerate() {
+            for (c, rate) in row.iter().enumerate() {
+                rows.push(vec![
+                    spatter_io::fmt_f64(edges[a]),
+                    spatter_io::fmt_f64(edges[a + 1]),
+                    spatter_io::fmt_f64(classes.diameters[c] * 1e6),
+                    spatter_io::fmt_f64(ground[a].u_star),
+                    spatter_io::fmt_f64(*rate),
+                ]);
+            }
+        }
+        let path = ctx.dir.path("entrainment_source.csv");
+        spatter_io::csv::write_table(
+            &path,
+            &["r_inner_m", "r_outer_m", "d_um", "mean_u_star_m_s", "rate_kg_s"],
+            &rows,
+        )?;
+        summary.artifacts.push(("entrainment source".into(), path));
+    }
+    let source = DustSource::new(
+        Vec3::ZERO,
+        edges,
+        classes.diameters.clone(),
+        rho_p,
+        rates,
+        cfg.cloud.parcel_mass_kg,
+        cfg.cloud.release_height_m,
+        cfg.cloud.seed,
+    );
+    let total_rate = source.total_rate();
+    summary.scalar("entrainment_rate_kg_s", total_rate);
+    let parcels = total_rate * cfg.cloud.duration_s / cfg.cloud.parcel_mass_kg;
+    if parcels > MAX_PARCELS {
+        return Err(BrownoutError::Invalid(vec![Invalid {
+            key: "cloud.parcel_mass_kg".into(),
+            message: format!(
+                "parcel_mass_kg = {:e} kg: the source gives {total_rate:.4e} kg/s, so duration_s = {} s would release {parcels:.3e} parcels (at most {MAX_PARCELS:e}); choose a parcel mass of at least {:.3e} kg",
+                cfg.cloud.parcel_mass_kg,
+                cfg.cloud.duration_s,
+                total_rate * cfg.cloud.duration_s / MAX_PARCELS
+            ),
+        }]));
+    }
+
+    // 3. The cloud.
+    let dt = cfg.cloud.dt_s;
+    let domain = cfg.domain();
+    let settings =
+        TrackSettings { dt, domain: Some(domain), dispersion: None, max_bounces: 8, resort_interval: 0 };
+    let model = ForceModel::new(air, ForceSwitches::default());
+    let mut sim = CloudSim::new(field, model, settings, source);
+    let mut grid = CloudGrid::new(domain, cfg.output.grid_cells);
+    let lines = &cfg.output.lines_of_sight;
+    let mut optics_cols = vec!["time_s".to_owned()];
+    optics_cols.extend(lines.iter().map(|l| format!("tau_{}", l.name)));
+    let optics_cols: Vec<&str> = optics_cols.iter().map(String::as_str).collect();
+    let balance_path = ctx.dir.path("cloud_balance.csv");
+    let optics_path = ctx.dir.path("optical_depth.csv");
+    let pvd_path = ctx.dir.path("cloud.pvd");
+    let ckpt = ctx.dir.checkpoint_path();
+    let mut next_output = 0u64;
+    let (mut bal_csv, mut opt_csv, mut pvd) = if ctx.resume && ckpt.is_file() {
+        // The checkpoint's header carries the input hash: another scenario's checkpoint is refused here.
+        let c: Checkpoint = ctx.load_checkpoint().map_err(|e| BrownoutError::Checkpoint(e.to_string()))?;
+        sim.tracker.state = c.state;
+        sim.source = c.source;
+        next_output = c.next_output;
+        let mut pvd = PvdSeries::load_or_new(&pvd_path)?;
+        pvd.truncate_after(sim.tracker.state.time)?;
+        (
+            CsvSeries::resume(&balance_path, &BALANCE_COLUMNS, c.balance_bytes)?,
+            CsvSeries::resume(&optics_path, &optics_cols, c.optics_bytes)?,
+            pvd,
+        )
+    } else {
+        (
+            CsvSeries::create(&balance_path, &BALANCE_COLUMNS)?,
+            CsvSeries::create(&optics_path, &optics_cols)?,
+            PvdSeries::new(&pvd_path),
+        )
+    };
+    let n_steps = (cfg.cloud.duration_s / dt).round() as u64;
+    let interval = cfg.output.interval_s;
+    let mut write_outputs = |sim: &CloudSim<AnalyticSet>,
+                             k: &mut u64,
+                             bal: &mut CsvSeries,
+                             opt: &mut CsvSeries,
+                             pvd: &mut PvdSeries|
+     -> std::io::Result<()> {
+        let t = sim.tracker.state.time;
+        bal.row(&balance_row(t, &sim.balance(), sim.tracker.airborne()))?;
+        grid.fill(&sim.tracker.state.parcels, LARGE_PARTICLE_EXTINCTION);
+        let mut row = vec![t];
+        row.extend(lines.iter().map(|l| grid.optical_depth(l.from_m, l.to_m)));
+        opt.row(&row)?;
+        let rel = format!("cloud/cloud_{k:05}.vtu");
+        std::fs::create_dir_all(ctx.dir.path("cloud"))?;
+        grid.write_vtu(&ctx.dir.path(&rel))?;
+        pvd.push(t, &rel)?;
+        *k += 1;
+        Ok(())
+    };
+    if sim.tracker.state.step == 0 && next_output == 0 {
+        write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+    }
+    let due = |t: f64, k: u64| t >= k as f64 * interval - 1e-9 * dt;
+    let mut last_written = u64::MAX;
+    while sim.tracker.state.step < n_steps {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
+            bal_csv.flush()?;
+            opt_csv.flush()?;
+            let c = Checkpoint {
+                state: sim.tracker.state.clone(),
+                source: sim.source.clone(),
+                next_output,
+                balance_bytes: bal_csv.bytes_written(),
+                optics_bytes: opt_csv.bytes_written(),
+            };
+            ctx.save_checkpoint(&c).map_err(|e| BrownoutError::Checkpoint(e.to_string()))?;
+            if stop {
+                let mut s = RunSummary::new(Finished::Interrupted);
+                s.headline.push(format!(
+                    "stopped at t = {:.6} s (step {} of {n_steps}); checkpoint written to {}",
+                    sim.tracker.state.time,
+                    sim.tracker.state.step,
+                    ckpt.display()
+                ));
+                return Ok(s);
+            }
+        }
+        sim.step()?;
+        if due(sim.tracker.state.time, next_output) {
+            write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+            last_written = sim.tracker.state.step;
+        }
+        ctx.control.progress(sim.tracker.state.step, n_steps);
+    }
+    if last_written != sim.tracker.state.step {
+        write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+    }
+    bal_csv.flush()?;
+    opt_csv.flush()?;
+    // A finished run leaves no checkpoint behind.
+    if ckpt.exists() {
+        std::fs::remove_file(&ckpt)?;
+    }
+
+    // 4. Pictures of the time series.
+    let (_, bal_rows) = spatter_io::csv::read_series(&balance_path)?;
+    let col = |k: usize| -> Vec<(f64, f64)> { bal_rows.iter().map(|r| (r[0], r[k])).collect() };
+    let mass_png = ctx.dir.path("entrained_mass.png");
+    Chart::new("dust mass: entrained = airborne + redeposited + left", "time [s]", "mass [kg]")
+        .size(900, 600)
+        .line("entrained", &col(1))
+        .line("airborne", &col(2))
+        .line("redeposited", &col(3))
+        .line("left the domain", &col(4))
+        .save_png(&mass_png)?;
+    let (_, opt_rows) = spatter_io::csv::read_series(&optics_path)?;
+    let tau_png = ctx.dir.path("optical_depth.png");
+    let mut chart = Chart::new(
+        "optical depth along the lines of sight (Q_ext = 2); transmission e^(−τ)",
+        "time [s]",
+        "optical depth τ",
+    )
+    .size(900, 600);
+    for (k, l) in lines.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = opt_rows.iter().map(|r| (r[0], r[k + 1])).collect();
+        chart = chart.line(&l.name, &pts);
+    }
+    chart.save_png(&tau_png)?;
+    for (label, path) in [
+        ("cloud mass balance", balance_path),
+        ("entrained mass curve", mass_png),
+        ("concentration field", pvd_path),
+        ("optical depth table", optics_path),
+        ("optical depth plot", tau_png),
+    ] {
+        summary.artifacts.push((label.into(), path));
+    }
+    let b = sim.balance();
+    let (lhs, rhs) = sim.tracker.mass_balance();
+    summary.headline.push(format!(
+        "cloud at t = {:.3} s: entrained {:.4e} kg = airborne {:.4e} + redeposited {:.4e} + left {:.4e} kg (residual {:e} kg); source {:.4e} kg/s",
+        sim.tracker.state.time, b.entrained, b.airborne, b.redeposited, b.left, lhs - rhs, total_rate
+    ));
+    for (k, l) in lines.iter().enumerate() {
+        let tau = opt_rows.last().map(|r| r[k + 1]).unwrap_or(0.0);
+        summary.headline.push(format!(
+            "line of sight `{}`: optical depth {tau:.4e} at the end (transmission {:.4})",
+            l.name,
+            (-tau).exp()
+        ));
+        summary.scalar(&format!("optical_depth_{}", l.name), tau);
+    }
+    for (name, v) in [
+        ("entrained_kg", b.entrained),
+        ("airborne_kg", b.airborne),
+        ("redeposited_kg", b.redeposited),
+        ("left_kg", b.left),
+        ("mass_balance_residual_kg", lhs - rhs),
+    ] {
+        summary.scalar(name, v);
+    }
+    Ok(summary)
+}

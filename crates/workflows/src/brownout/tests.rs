@@ -1,0 +1,202 @@
+use super::config::*;
+use super::run;
+use spatter_core::check::{Checker, Invalid};
+use spatter_core::control::{Finished, StopAfterPolls, Unattended};
+use spatter_core::Vec3;
+use spatter_flow::liftoff::entrainment::{EntrainmentModel, Threshold};
+use spatter_io::run::{RunContext, RunDir};
+use std::path::Path;
+
+/// The Bell 47 of Jasion (2013) Ch. 6 (after Leese 1964): R = 5.66 m, T = W = 8.8 kN, Ω = 35.6 rad/s,
+/// z_d/R = 0.68, over Rodgers' desert sand (normal by mass, 300 ± 120 µm, 10–500 µm), a short cloud on
+/// the mean flow (tip vortices off to keep the test fast).
+fn bell47() -> BrownoutConfig {
+    let text = r#"
+[rotor]
+radius_m = 5.66
+thrust_n = 8800.0
+omega_rad_s = 35.6
+height_over_radius = 0.68
+[ground]
+size = { kind = "normal_by_mass", mean_m = 300e-6, std_dev_m = 120e-6, min_m = 10e-6, max_m = 500e-6, classes = 6 }
+[liftoff]
+points = 24
+diameters_m = [10e-6, 300e-6, 500e-6]
+[entrainment]
+model = { model = "white" }
+gust_factor = 1.3
+annuli = 14
+[cloud]
+dt_s = 4e-3
+duration_s = 0.4
+parcel_mass_kg = 1e-7
+[output]
+interval_s = 0.1
+grid_cells = [16, 16, 8]
+[[output.lines_of_sight]]
+name = "low"
+from_m = [-12.0, 0.0, 0.1]
+to_m = [12.0, 0.0, 0.1]
+[[output.lines_of_sight]]
+name = "high"
+from_m = [-12.0, 0.0, 10.0]
+to_m = [12.0, 0.0, 10.0]
+"#;
+    toml::from_str(text).unwrap()
+}
+
+fn keys(e: &[Invalid]) -> Vec<&str> {
+    e.iter().map(|i| i.key.as_str()).collect()
+}
+
+#[test]
+fn the_bell47_configuration_is_valid() {
+    Checker::run(&bell47(), None).unwrap();
+}
+
+#[test]
+fn bad_input_is_named_by_key() {
+    let mut c = bell47();
+    c.rotor.height_over_radius = -0.2;
+    let e = Checker::run(&c, None).unwrap_err();
+    assert_eq!(keys(&e), ["rotor.height_over_radius"]);
+    assert!(e[0].message.contains("below the ground"), "{}", e[0].message);
+
+    let mut c = bell47();
+    c.rotor.thrust_n = Some(-8800.0);
+    let e = Checker::run(&c, None).unwrap_err();
+    assert_eq!(keys(&e), ["rotor.thrust_n"]);
+    assert!(e[0].message.contains("-8800"), "{}", e[0].message);
+
+    let mut c = bell47();
+    c.rotor.thrust_coefficient = Some(0.02);
+    let e = Checker::run(&c, None).unwrap_err();
+    assert_eq!(keys(&e), ["rotor.thrust_n"]);
+    assert!(e[0].message.contains("not both"), "{}", e[0].message);
+
+    let mut c = bell47();
+    c.ground.size = SizeConfig::Classes { diameters_m: vec![100e-6, 200e-6], mass_weights: vec![0.0, 0.0] };
+    let e = Checker::run(&c, None).unwrap_err();
+    assert_eq!(keys(&e), ["ground.size"]);
+    assert!(e[0].message.contains("mass"), "{}", e[0].message);
+
+    let mut c = bell47();
+    c.output.lines_of_sight[1].to_m = Vec3::new(12.0, 0.0, 40.0);
+    let e = Checker::run(&c, None).unwrap_err();
+    assert_eq!(keys(&e), ["output.lines_of_sight[1].to_m"]);
+    assert!(e[0].message.contains("outside the cloud domain"), "{}", e[0].message);
+}
+
+#[test]
+fn thrust_coefficient_gives_the_thrust_of_the_british_convention() {
+    // C_T = T/(½ρπR²(ΩR)²) (Jasion 2013 eq. 4.23); the Bell 47 (8.8 kN, R = 5.66 m, Ω = 35.6 rad/s) in
+    // air of 1.19 kg/m³: by hand 8800/(0.5·1.19·π·5.66²·(35.6·5.66)²) = 3.6195e-3.
+    let mut c = bell47();
+    let rho = 1.19;
+    let r = 5.66;
+    let ct = 8800.0 / (0.5 * rho * std::f64::consts::PI * r * r * (35.6f64 * r).powi(2));
+    c.rotor.thrust_n = None;
+    c.rotor.thrust_coefficient = Some(ct);
+    assert!((c.rotor.thrust(rho) - 8800.0).abs() < 1e-9);
+    assert!((ct - 3.6195e-3).abs() < 1e-7, "{ct}");
+}
+
+fn csv(path: &Path) -> Vec<Vec<f64>> {
+    spatter_io::csv::read_series(path).unwrap().1
+}
+
+fn scalar(s: &spatter_io::run::RunSummary, name: &str) -> f64 {
+    s.scalars.iter().find(|(n, _)| n == name).map(|(_, v)| *v).unwrap()
+}
+
+#[test]
+fn bell47_run_lifts_medium_grains_first_and_balances_the_cloud() {
+    let cfg = bell47();
+    let root = tempfile::tempdir().unwrap();
+    let d = RunDir::create(root.path()).unwrap();
+    let s = run(&cfg, &RunContext::new(&d, &Unattended, false)).unwrap();
+    assert_eq!(s.finished, Finished::Completed);
+    for (label, path) in &s.artifacts {
+        assert!(path.exists(), "{label}: {}", path.display());
+    }
+    // Jasion (2013) Ch. 6: of 10, 300 and 500 µm grains, 300 µm lift off first (medium grains: small ones
+    // held by cohesion, large ones by weight), at 0.5 < r/R < 1.5.
+    assert_eq!(scalar(&s, "most_liftable_diameter_um"), 300.0);
+
+    // The source: White's flux is non-zero exactly where the friction velocity beats the Shao–Lu
+    // threshold of the class (Shao & Lu 2000 with Haehnel's constants).
+    let rows = csv(&d.path("entrainment_source.csv"));
+    assert_eq!(rows.len(), 14 * 6);
+    let mut emitting = 0;
+    for r in &rows {
+        let u_t = Threshold::SHAO_LU.friction_velocity(r[2] * 1e-6, 2480.0, 1.19, 9.81);
+        assert_eq!(r[4] > 0.0, r[3] > u_t, "{r:?} against u*t = {u_t}");
+        emitting += usize::from(r[4] > 0.0);
+    }
+    assert!(emitting > 0);
+    let rate: f64 = rows.iter().map(|r| r[4]).sum();
+    assert!((rate - scalar(&s, "entrainment_rate_kg_s")).abs() <= 1e-12 * rate);
+
+    // The cloud: the source emits rate × t (released + pending, to round-off), and the tracker's
+    // balance entrained = airborne + redeposited + left holds bit for bit.
+    let bal = csv(&d.path("cloud_balance.csv"));
+    assert_eq!(bal.len(), 5, "rows at t = 0, 0.1, …, 0.4 s");
+    let last = bal.last().unwrap();
+    assert!((last[0] - 0.4).abs() < 1e-9);
+    assert!((last[1] + last[5] - rate * 0.4).abs() < 1e-9 * rate, "{last:?}");
+    assert!(last[1] > 0.0 && last[2] > 0.0, "{last:?}");
+    assert_eq!(scalar(&s, "mass_balance_residual_kg"), 0.0);
+    // Optical depth: the dust stays near the ground in 0.4 s; the high line sees none.
+    let tau = csv(&d.path("optical_depth.csv"));
+    assert_eq!(tau.len(), 5);
+    assert!(tau.last().unwrap()[1] > 0.0 && tau.last().unwrap()[2] == 0.0, "{tau:?}");
+    assert_eq!(tau[0][1], 0.0);
+    // One concentration snapshot per row.
+    let vtus = std::fs::read_dir(d.path("cloud")).unwrap().count();
+    assert_eq!(vtus, 5);
+}
+
+#[test]
+fn an_absurd_parcel_count_is_refused_before_tracking() {
+    let mut cfg = bell47();
+    cfg.cloud.parcel_mass_kg = 1e-15;
+    let root = tempfile::tempdir().unwrap();
+    let d = RunDir::create(root.path()).unwrap();
+    let e = run(&cfg, &RunContext::new(&d, &Unattended, false)).unwrap_err();
+    assert!(e.to_string().contains("cloud.parcel_mass_kg"), "{e}");
+    assert!(!d.path("cloud_balance.csv").exists());
+}
+
+#[test]
+fn a_stopped_and_resumed_run_writes_the_same_files() {
+    let mut cfg = bell47();
+    cfg.entrainment.model = EntrainmentModel::Haehnel { coefficient: 0.05 };
+    let root = tempfile::tempdir().unwrap();
+    let a = RunDir::create(&root.path().join("a")).unwrap();
+    assert_eq!(run(&cfg, &RunContext::new(&a, &Unattended, false)).unwrap().finished, Finished::Completed);
+    let b = RunDir::create(&root.path().join("b")).unwrap();
+    let stop = StopAfterPolls::new(37);
+    assert_eq!(run(&cfg, &RunContext::new(&b, &stop, false)).unwrap().finished, Finished::Interrupted);
+    assert!(b.checkpoint_path().exists());
+    assert_eq!(run(&cfg, &RunContext::new(&b, &Unattended, true)).unwrap().finished, Finished::Completed);
+    assert!(!b.checkpoint_path().exists(), "a finished run removes its checkpoint");
+    let mut compared = 0;
+    for rel in ["cloud_balance.csv", "optical_depth.csv", "entrainment_source.csv", "cloud.pvd"] {
+        assert!(std::fs::read(a.path(rel)).unwrap() == std::fs::read(b.path(rel)).unwrap(), "{rel}");
+        compared += 1;
+    }
+    for e in std::fs::read_dir(a.path("cloud")).unwrap() {
+        let name = e.unwrap().file_name();
+        let rel = format!("cloud/{}", name.to_string_lossy());
+        assert!(std::fs::read(a.path(&rel)).unwrap() == std::fs::read(b.path(&rel)).unwrap(), "{rel}");
+        compared += 1;
+    }
+    assert_eq!(compared, 9);
+    // Another scenario's checkpoint (another input hash) is refused.
+    let c = RunDir::create(&root.path().join("c")).unwrap();
+    let stop = StopAfterPolls::new(5);
+    assert_eq!(run(&cfg, &RunContext::new(&c, &stop, false)).unwrap().finished, Finished::Interrupted);
+    let ctx = RunContext { input_hash: 12, ..RunContext::new(&c, &Unattended, true) };
+    let e = run(&cfg, &ctx).unwrap_err().to_string();
+    assert!(e.contains("checkpoint.bin") && e.contains("different scenario"), "{e}");
+}
