@@ -221,6 +221,10 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             rayon::current_num_threads()
         ))
         .map_err(io_at(&log_path))?;
+        for w in &info.warnings {
+            tracing::warn!("{w}");
+            log.line(&format!("warning: {w}")).map_err(io_at(&log_path))?;
+        }
         let cols = series_columns(cfg, &sim);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let series = CsvSeries::create(&series_path, &cols).map_err(io_at(&series_path))?;
