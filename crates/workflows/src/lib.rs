@@ -2,3 +2,4 @@
 
 pub mod deposition;
 pub mod snow;
+pub mod wading;

@@ -1,0 +1,9 @@
+//! The wading workflow (in progress): a vehicle made of named parts drives through a wading channel.
+//!
+//! Built so far: the channel generated from a few numbers with the still water's extent, wheels placed on
+//! its road and the body's pitch from the axle heights ([`channel`]); the vehicle's parts read from
+//! multi-solid STL files, and the reach of a wheel mesh from its axle ([`parts`]). The scenario kind, the
+//! run loop on the SPH engine and the reports are still to come (issue #20).
+
+pub mod channel;
+pub mod parts;
