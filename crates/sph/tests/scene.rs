@@ -488,3 +488,24 @@ fn wet_time_is_the_time_under_water() {
     // 20 rows beside the water less the 3 that went below the floor; 3 rows reach the water line.
     assert_eq!((submerged, arriving), (17, 3));
 }
+
+/// A wall adhesion outside the calibrated range 0.5–2 is reported in the log (one line per wall, naming
+/// it), and a wall inside it is not; without surface tension adhesion has no effect and nothing is said.
+#[test]
+fn adhesion_outside_the_calibrated_range_is_logged() {
+    let with = |st: f64, f: f64| {
+        SMALL
+            .replace("spacing_m = 0.01", &format!("spacing_m = 0.01\nsurface_tension_n_m = {st}"))
+            .replace("max_m = [0.4, 0.0, 0.3]\n", &format!("max_m = [0.4, 0.0, 0.3]\nadhesion = {f}\n"))
+            .replace("end_time_s = 0.05", "end_time_s = 0.002")
+            .replace("window_s = [0.01, 0.05]", "window_s = [0.0, 0.002]")
+    };
+    for (st, f, warned) in [(0.072, 10.0, true), (0.072, 1.0, false), (0.0, 10.0, false)] {
+        let cfg = config(&with(st, f));
+        let tmp = tempfile::tempdir().unwrap();
+        run_to_end(&cfg, tmp.path());
+        let log = std::fs::read_to_string(tmp.path().join("log.txt")).unwrap();
+        let line = "warning: wall `tank`: adhesion 10 is above the calibrated range 0.5–2";
+        assert_eq!(log.contains(line), warned, "σ = {st}, adhesion {f}:\n{log}");
+    }
+}
