@@ -57,6 +57,9 @@ pub struct SessileResult {
     pub residual_motion: f64,
     /// Particles removed during the run (the drop left the plate or broke up).
     pub removed: u64,
+    /// Height of the lowest particle's centre above the plate at the end \[m\]: dp/2 for liquid resting
+    /// on the wall as water filled against it does.
+    pub standoff: f64,
 }
 
 impl SessileResult {
@@ -155,6 +158,7 @@ pub fn sessile_drop(d: &SessileDrop) -> Result<SessileResult, SphError> {
         height,
         residual_motion: sim.kinetic_energy() / energy_scale,
         removed: sim.removed.outside_domain + sim.removed.density_window,
+        standoff: zmin,
     })
 }
 
