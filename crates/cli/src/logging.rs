@@ -1,21 +1,27 @@
-//! Logging: every event goes to the run's `log.txt`; warnings and errors also to the terminal (printed
-//! above the progress bar).
+//! Logging: one `tracing` subscriber for the whole program. Every event goes to the current run's
+//! `log.txt` (through [`spatter_io::runlog`], which the job driver points at the run folder); events at or
+//! above the terminal level also go to stderr (printed above the progress bar).
+//!
+//! Terminal level: warnings by default, errors only with `-q`, information with `-v`, debug with `-vv`,
+//! everything with `-vvv`. The log file gets information and above (debug with `-vv`). `RUST_LOG`
+//! (`warn`, `debug`, `spatter_sph=debug,info`, …) replaces the file's filter when set.
 
 use indicatif::ProgressBar;
-use std::fs::File;
 use std::io::{self, Write};
-use std::sync::{Arc, Mutex};
 use tracing::{Level, Metadata};
+use tracing_subscriber::filter::{LevelFilter, Targets};
 use tracing_subscriber::fmt::MakeWriter;
+use tracing_subscriber::layer::SubscriberExt;
+use tracing_subscriber::util::SubscriberInitExt;
+use tracing_subscriber::Layer;
 
 #[derive(Clone)]
-pub struct Tee {
-    file: Option<Arc<Mutex<File>>>,
+struct Tee {
     bar: ProgressBar,
+    terminal: Level,
 }
 
-pub struct TeeWriter {
-    file: Option<Arc<Mutex<File>>>,
+struct TeeWriter {
     bar: Option<ProgressBar>,
     buf: Vec<u8>,
 }
@@ -33,12 +39,7 @@ impl Write for TeeWriter {
 
 impl Drop for TeeWriter {
     fn drop(&mut self) {
-        if let Some(f) = &self.file {
-            if let Ok(mut f) = f.lock() {
-                let _ = f.write_all(&self.buf);
-                let _ = f.flush();
-            }
-        }
+        spatter_io::runlog::append(&self.buf);
         if let Some(bar) = &self.bar {
             let text = String::from_utf8_lossy(&self.buf).into_owned();
             bar.suspend(|| eprint!("{text}"));
@@ -50,27 +51,63 @@ impl<'a> MakeWriter<'a> for Tee {
     type Writer = TeeWriter;
 
     fn make_writer(&'a self) -> TeeWriter {
-        TeeWriter { file: self.file.clone(), bar: Some(self.bar.clone()), buf: Vec::new() }
+        TeeWriter { bar: Some(self.bar.clone()), buf: Vec::new() }
     }
 
     fn make_writer_for(&'a self, meta: &Metadata<'_>) -> TeeWriter {
-        let to_terminal = *meta.level() <= Level::WARN;
-        TeeWriter { file: self.file.clone(), bar: to_terminal.then(|| self.bar.clone()), buf: Vec::new() }
+        let to_terminal = *meta.level() <= self.terminal;
+        TeeWriter { bar: to_terminal.then(|| self.bar.clone()), buf: Vec::new() }
     }
 }
 
-/// Routes `tracing` events to `log_file` (appending) and warnings to the terminal. Call once per process.
-pub fn init(log_file: Option<&std::path::Path>, bar: &ProgressBar) -> io::Result<()> {
-    let file = match log_file {
-        Some(p) => Some(Arc::new(Mutex::new(std::fs::OpenOptions::new().create(true).append(true).open(p)?))),
-        None => None,
+/// Terminal level for `-v` count `verbose` and `-q`.
+fn terminal_level(verbose: u8, quiet: bool) -> Level {
+    match (quiet, verbose) {
+        (true, _) => Level::ERROR,
+        (false, 0) => Level::WARN,
+        (false, 1) => Level::INFO,
+        (false, 2) => Level::DEBUG,
+        _ => Level::TRACE,
+    }
+}
+
+/// Installs the subscriber (once per process). Returns a note when `RUST_LOG` could not be read.
+pub fn init(bar: &ProgressBar, verbose: u8, quiet: bool) -> Option<String> {
+    let terminal = terminal_level(verbose, quiet);
+    let file_level = if verbose >= 2 { terminal } else { Level::INFO };
+    let mut note = None;
+    let filter = match std::env::var("RUST_LOG") {
+        Ok(spec) if !spec.trim().is_empty() => match spec.parse::<Targets>() {
+            Ok(t) => t,
+            Err(e) => {
+                note = Some(format!(
+                    "RUST_LOG={spec:?} ignored ({e}); expected e.g. `debug` or `spatter_sph=debug,info`"
+                ));
+                Targets::new().with_default(LevelFilter::from_level(file_level))
+            }
+        },
+        _ => Targets::new().with_default(LevelFilter::from_level(file_level.max(terminal))),
     };
-    let tee = Tee { file, bar: bar.clone() };
-    let _ = tracing_subscriber::fmt()
+    let tee = Tee { bar: bar.clone(), terminal };
+    let layer = tracing_subscriber::fmt::layer()
         .with_writer(tee)
         .with_ansi(false)
         .with_target(false)
-        .with_max_level(Level::INFO)
-        .try_init();
-    Ok(())
+        .with_filter(filter);
+    let _ = tracing_subscriber::registry().with(layer).try_init();
+    note
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn verbosity_flags_map_to_levels() {
+        assert_eq!(terminal_level(0, false), Level::WARN);
+        assert_eq!(terminal_level(1, false), Level::INFO);
+        assert_eq!(terminal_level(2, false), Level::DEBUG);
+        assert_eq!(terminal_level(5, false), Level::TRACE);
+        assert_eq!(terminal_level(3, true), Level::ERROR);
+    }
 }

@@ -16,10 +16,12 @@ Examples:
   spatter demo                                   # snow regime map on the built-in scenario, no files needed
   spatter run examples/snow_regime_map.toml      # run a scenario; results in runs/snow_regime_map/
   spatter run study.toml --out runs/a --threads 2
-  spatter run study.toml --out runs/a --resume   # continue after Ctrl-C
+  spatter run study.toml --out runs/a --resume   # continue after Ctrl-C, SIGTERM or a kill
+  spatter run study.toml --out runs/a --overwrite # replace an earlier run's files
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
   spatter bench dem                              # throughput of an engine
+  spatter sweep examples/snow_sobol_study.toml   # parameter study: results table, Sobol indices, report
   spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV
   spatter sessile --adhesion 0.6,0.8,1.0         # SPH contact angle per wall adhesion factor (calibration)
   spatter sessile --contact-angle glass=25       # adhesion factor that gives a measured contact angle";
@@ -47,8 +49,23 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
         /// Continue from the checkpoint in the output folder.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "overwrite")]
         resume: bool,
+        /// Delete the files of an earlier run in the output folder before starting.
+        #[arg(long)]
+        overwrite: bool,
+        /// Wall-clock seconds between periodic checkpoints (a kill loses at most this much work).
+        #[arg(long, default_value_t = spatter_scenario::job::DEFAULT_CHECKPOINT_INTERVAL_S)]
+        checkpoint_interval_s: f64,
+        /// More messages on the terminal (-v information, -vv debug); `RUST_LOG` filters the log file.
+        #[arg(short, long, action = clap::ArgAction::Count, conflicts_with = "quiet")]
+        verbose: u8,
+        /// Errors only on the terminal, no progress.
+        #[arg(short, long)]
+        quiet: bool,
+        /// A reduced run (a few steps, parcels or impacts) that exercises every output in seconds.
+        #[arg(long)]
+        smoke: bool,
     },
     /// Validate a scenario and print the fully resolved input (defaults filled in).
     #[command(after_help = "Example:\n  spatter check examples/snow_regime_map.toml")]
@@ -127,6 +144,30 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Run a parameter study: every case of a study file (a base scenario and the keys to vary), then a
+    /// results table, plots, Sobol indices for sampled designs and report.html (docs/studies.md).
+    #[command(
+        args_conflicts_with_subcommands = true,
+        after_help = "Examples:\n  spatter sweep examples/snow_sobol_study.toml\n  spatter sweep study.toml --out runs/s --shard 3/8   # one task of a batch job array\n  spatter sweep collect study.toml --out runs/s        # table and report once every shard is done"
+    )]
+    Sweep {
+        #[command(subcommand)]
+        action: Option<SweepAction>,
+        /// Study file (TOML).
+        study: Option<PathBuf>,
+        /// Study folder [default: runs/<study file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run only shard i of n (every n-th case, starting at case i - 1), e.g. 2/8.
+        #[arg(long, value_parser = commands::sweep::parse_shard)]
+        shard: Option<(usize, usize)>,
+        /// Worker threads per case [default: all cores].
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Delete another study's cases found in the folder instead of refusing.
+        #[arg(long)]
+        overwrite: bool,
+    },
     /// Run a named benchmark and print its throughput.
     #[command(after_help = "Example:\n  spatter bench dem\n  spatter bench snow --quick")]
     Bench {
@@ -139,16 +180,57 @@ enum Command {
     },
 }
 
+#[derive(Subcommand, Debug)]
+enum SweepAction {
+    /// Build the results table, plots and report of a study whose shards have all finished.
+    Collect {
+        /// Study file (TOML).
+        study: PathBuf,
+        /// Study folder [default: runs/<study file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scenario, out, threads, resume } => {
-            commands::run::run_file(&scenario, out.as_deref(), threads, resume)
+        Command::Run {
+            scenario,
+            out,
+            threads,
+            resume,
+            overwrite,
+            checkpoint_interval_s,
+            verbose,
+            quiet,
+            smoke,
+        } => {
+            let args = commands::run::RunArgs {
+                out,
+                threads,
+                resume,
+                overwrite,
+                checkpoint_interval_s,
+                verbose,
+                quiet,
+                smoke,
+            };
+            commands::run::run_file(&scenario, &args)
         }
         Command::Check { scenario } => commands::check(&scenario),
         Command::Demo { out, threads } => commands::run::demo(&out, threads),
         Command::Validate { quick, case, csv } => commands::validate(quick, case.as_deref(), csv.as_deref()),
         Command::Bench { engine, quick } => commands::bench(&engine, quick),
+        Command::Sweep { action: Some(SweepAction::Collect { study, out }), .. } => {
+            commands::sweep::collect(&study, out.as_deref())
+        }
+        Command::Sweep { action: None, study: Some(study), out, shard, threads, overwrite } => {
+            commands::sweep::sweep(&study, out.as_deref(), shard, threads, overwrite)
+        }
+        Command::Sweep { action: None, study: None, .. } => {
+            Err(anyhow::anyhow!("spatter sweep needs a study file: spatter sweep STUDY.toml (see --help)"))
+        }
         Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
         Command::Sessile {
             adhesion,

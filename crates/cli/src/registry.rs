@@ -8,7 +8,7 @@ pub const DEMO_SCENARIO: (&str, &str) =
     ("examples/snow_regime_map.toml", include_str!("../../../examples/snow_regime_map.toml"));
 
 /// Names accepted by `spatter bench`.
-pub const BENCHES: &[&str] = &["dem", "sph", "snow", "track"];
+pub const BENCHES: &[&str] = &["dem", "sph", "snow", "track", "flow"];
 
 /// Every registered validation case, engine by engine.
 pub fn validation_cases() -> Vec<Case> {
@@ -16,6 +16,7 @@ pub fn validation_cases() -> Vec<Case> {
     cases.extend(spatter_workflows::snow::validation_cases());
     cases.extend(spatter_flow::validation::validation_cases());
     cases.extend(spatter_sph::validation::validation_cases());
+    cases.extend(spatter_cfd::validation::validation_cases());
     cases
 }
 
@@ -26,6 +27,7 @@ pub fn run_bench(name: &str, quick: bool) -> anyhow::Result<Vec<String>> {
         "sph" => Ok(spatter_sph::bench::bench(quick)?),
         "snow" => Ok(spatter_workflows::snow::bench(quick)?),
         "track" => Ok(spatter_flow::bench::bench(quick)?),
+        "flow" => Ok(spatter_cfd::bench::bench(quick)?),
         _ => anyhow::bail!("no benchmark named `{name}`; expected one of: {}", BENCHES.join(", ")),
     }
 }

@@ -167,6 +167,54 @@ impl Checker {
         }
     }
 
+    /// `path` (relative to the scenario's folder unless absolute) must name a mesh file (STL/OBJ) that
+    /// reads and is valid: triangles present, every coordinate finite, no zero-area triangle (see
+    /// [`crate::mesh::TriMesh::load`]). The message names the key, the file and the line or triangle.
+    pub fn mesh_file(&mut self, key: &str, path: &Path) {
+        let full = self.resolve(path);
+        if !full.is_file() {
+            return self.file_exists(key, path);
+        }
+        if let Err(e) = crate::mesh::TriMesh::load(&full, 1.0) {
+            self.fail(key, format!("{} = \"{}\": {e}", Self::name(key), path.display()));
+        }
+    }
+
+    /// `path` must name a motion table (`t vx vy vz wx wy wz` rows, times increasing) that parses; the
+    /// message names the key, the file and the line.
+    pub fn motion_table_file(&mut self, key: &str, path: &Path) {
+        let full = self.resolve(path);
+        if !full.is_file() {
+            return self.file_exists(key, path);
+        }
+        let parsed = std::fs::read_to_string(&full).map_err(|e| e.to_string()).and_then(|t| {
+            crate::motion::MotionTable::parse(&t, crate::Vec3::ZERO).map_err(|e| e.to_string())
+        });
+        if let Err(e) = parsed {
+            self.fail(key, format!("{} = \"{}\": {e}", Self::name(key), path.display()));
+        }
+    }
+
+    /// Refuses a run whose estimated memory `bytes` exceeds this machine's physical memory (1 TiB where
+    /// it cannot be read): `what` says what was estimated and from which values, so the user can see
+    /// which key to change. Checked before anything is allocated.
+    pub fn memory_estimate(&mut self, key: &str, what: &str, bytes: f64) {
+        let (limit, whose) = match physical_memory_bytes() {
+            Some(m) => (m as f64, "this machine's memory"),
+            None => (1024f64.powi(4), "the 1 TiB limit"),
+        };
+        if bytes.is_nan() || bytes > limit {
+            self.fail(
+                key,
+                format!(
+                    "{what} needs about {} of memory, more than {whose} ({}); choose a coarser or smaller setting",
+                    fmt_bytes(bytes),
+                    fmt_bytes(limit)
+                ),
+            );
+        }
+    }
+
     /// `path` resolved against the scenario's folder.
     pub fn resolve(&self, path: &Path) -> PathBuf {
         match &self.base_dir {
@@ -176,9 +224,49 @@ impl Checker {
     }
 }
 
+/// Physical memory of this machine in bytes (Linux `/proc/meminfo`), if it can be read.
+pub fn physical_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// `bytes` as "12.3 GB" (decimal units).
+pub fn fmt_bytes(bytes: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = bytes;
+    let mut k = 0;
+    while v >= 1000.0 && k + 1 < units.len() {
+        v /= 1000.0;
+        k += 1;
+    }
+    if k + 1 == units.len() && v >= 1000.0 {
+        return format!("{bytes:.3e} B");
+    }
+    format!("{v:.1} {}", units[k])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn absurd_memory_is_refused_with_the_estimate() {
+        let mut c = Checker::new(None);
+        c.memory_estimate("spacing_m", "1.2e9 particles × 300 B", 3.6e11 * 1e6);
+        c.memory_estimate("count", "a few particles", 1e6);
+        let e = c.finish().unwrap_err();
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert_eq!(e[0].key, "spacing_m");
+        assert!(
+            e[0].message.contains("1.2e9 particles") && e[0].message.contains("memory"),
+            "{}",
+            e[0].message
+        );
+        assert_eq!(fmt_bytes(1.5e9), "1.5 GB");
+        assert_eq!(fmt_bytes(999.0), "999.0 B");
+    }
 
     #[test]
     fn paths_and_messages() {

@@ -1,7 +1,8 @@
 //! How a long run learns that it should stop, and where it reports progress.
 //!
 //! Engines and workflows poll [`RunControl::stop_requested`] between steps; when it turns true they write
-//! a checkpoint, flush their outputs and return [`Finished::Interrupted`]. The CLI implements the trait with
+//! a checkpoint, flush their outputs and return [`Finished::Interrupted`]. When
+//! [`RunControl::checkpoint_due`] turns true they write a checkpoint and carry on. The CLI implements the trait with
 //! a Ctrl-C flag and a progress bar; tests use [`StopAfterPolls`] to interrupt a run at an exact point.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -14,6 +15,12 @@ pub trait RunControl: Sync {
     fn progress(&self, _done: u64, _total: u64) {}
     /// A short status line (phase names and the like).
     fn status(&self, _message: &str) {}
+    /// True when the job should write a checkpoint at its next safe point and carry on (the job driver
+    /// raises it every `checkpoint_interval_s` of wall time). Jobs poll it where they poll
+    /// [`RunControl::stop_requested`].
+    fn checkpoint_due(&self) -> bool {
+        false
+    }
 }
 
 /// Whether a job ran to its end or stopped early on request.

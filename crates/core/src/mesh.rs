@@ -114,10 +114,41 @@ impl TriMesh {
                 message: format!("vertex {i} has a non-finite coordinate"),
             });
         }
+        if let Some(message) = mesh.zero_area_report() {
+            return Err(MeshError::Invalid { path: path.to_owned(), message });
+        }
         if scale != 1.0 {
             mesh.vertices.iter_mut().for_each(|v| *v *= scale);
         }
         Ok(mesh)
+    }
+
+    /// Names the first zero-area triangle (corners on one line, area below 1e-12 of the squared bounding
+    /// box diagonal) and how many there are, or `None`. Such triangles have no normal: contacts with them
+    /// would be lost or undefined, so a mesh that holds any is refused rather than silently thinned.
+    pub fn zero_area_report(&self) -> Option<String> {
+        let diag2 = self.bounds().extent().length_squared();
+        let tol = 1e-12 * diag2;
+        let bad: Vec<usize> =
+            (0..self.triangles.len()).filter(|&t| self.area(t).is_nan() || self.area(t) <= tol).collect();
+        let first = *bad.first()?;
+        let [a, b, c] = self.corners(first);
+        Some(format!(
+            "{} of its {} triangles have zero area, the first is triangle {first} (0-based, in file order after \
+             dropping triangles with two equal corners) with corners [{}, {}, {}], [{}, {}, {}], [{}, {}, {}]; \
+             repair the mesh (remove zero-area faces) and export it again",
+            bad.len(),
+            self.triangles.len(),
+            a.x,
+            a.y,
+            a.z,
+            b.x,
+            b.y,
+            b.z,
+            c.x,
+            c.y,
+            c.z
+        ))
     }
 
     /// Parses STL bytes. A file whose size is exactly 84 + 50·n for the count n in its header is binary,
@@ -461,6 +492,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A triangle with three distinct but collinear corners survives welding and has no normal: loading
+    /// refuses the mesh, naming the triangle; a clean mesh loads.
+    #[test]
+    fn zero_area_triangles_are_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("good.stl");
+        std::fs::write(&good, TriMesh::rectangle(1.0, 1.0, 0.0, 2, 2).to_binary_stl()).unwrap();
+        assert!(TriMesh::load(&good, 1.0).is_ok());
+        let mut m = TriMesh::rectangle(1.0, 1.0, 0.0, 2, 2);
+        m.vertices.push(Vec3::new(2.0, 0.0, 0.0));
+        m.vertices.push(Vec3::new(3.0, 0.0, 0.0));
+        m.vertices.push(Vec3::new(4.0, 0.0, 0.0));
+        let n = m.vertices.len() as u32;
+        m.triangles.push([n - 3, n - 2, n - 1]);
+        let bad = dir.path().join("bad.stl");
+        std::fs::write(&bad, m.to_binary_stl()).unwrap();
+        let e = TriMesh::load(&bad, 1.0).unwrap_err().to_string();
+        assert!(e.contains("bad.stl") && e.contains("1 of its 9 triangles have zero area"), "{e}");
+        assert!(e.contains("triangle 8"), "{e}");
     }
 
     #[test]

@@ -10,7 +10,6 @@ pub mod insertion;
 pub mod output;
 pub mod par;
 pub mod particles;
-pub mod scene;
 pub mod sim;
 pub mod timestep;
 pub mod validation;
@@ -18,6 +17,5 @@ pub mod walls;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};
-pub use scene::{run, SceneConfig};
 pub use sim::{EnergyMethod, EnergyReport, Integrator, Settings, Simulation};
 pub use validation::validation_cases;

@@ -28,7 +28,7 @@ use spatter_core::mesh::TriMesh;
 use spatter_core::validation::{Case, Check};
 use spatter_core::{Aabb, Vec3};
 
-const DIGEST: &str = "digests/seed_003_brownout.md";
+const JASION: &str = "Jasion (2013), PhD thesis, Southampton";
 
 /// Every flow case.
 pub fn validation_cases() -> Vec<Case> {
@@ -46,7 +46,7 @@ pub fn validation_cases() -> Vec<Case> {
 
 fn table_6_4(_quick: bool) -> Vec<Check> {
     let r = reference_terms(&table_6_4_input());
-    let src = "Jasion 2013 Table 6.4 (digests/seed_003_brownout.md §6.2–6.3), 3 significant figures";
+    let src = "Jasion 2013 Table 6.4, 3 significant figures";
     let sizes = ["10 µm", "300 µm", "500 µm"];
     let table: [(&str, [f64; 3]); 10] = [
         ("F_D0", [2.20e-3, 7.34e-5, 4.40e-5]),
@@ -86,9 +86,9 @@ fn closed_forms(_quick: bool) -> Vec<Check> {
     let c = |q: &str, reference: f64, ours: f64, tol: f64, src: &str| {
         Check::relative("flow_closed_forms", q, reference, ours, tol, src)
     };
-    let d61 = format!("{DIGEST} §6.1");
-    let ver = "VERIFICATION.md (Di Felice 1994)";
-    let d64 = format!("{DIGEST} §6.4");
+    let d61 = format!("{JASION}, closed forms of chapter 6");
+    let ver = "Di Felice (1994), Int. J. Multiphase Flow 20:153";
+    let d64 = format!("{JASION}, chapter 6 (wall effects)");
     let mut out = vec![
         c("Schiller–Naumann f(1) [-]", 1.15, schiller_naumann_fd(1.0), 5e-5, &d61),
         c("Schiller–Naumann f(100) [-]", 4.5489, schiller_naumann_fd(100.0), 5e-5, &d61),

@@ -4,14 +4,20 @@
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
-//! * [`checkpoint`] — atomic, versioned binary snapshots of a job's state;
-//! * [`plot`] — PNG/SVG charts and mesh colour maps.
+//! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
+//! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
+//! * [`plot`] — PNG/SVG charts and mesh colour maps;
+//! * [`summary`] — `summary.json`, a run's result in machine-readable form;
+//! * [`report`] — self-contained HTML reports of runs and studies.
 
 pub mod checkpoint;
 pub mod csv;
 pub mod plot;
 pub mod pvd;
+pub mod report;
 pub mod run;
+pub mod runlog;
+pub mod summary;
 pub mod vtu;
 
 /// Formats `x` so that it parses back to the same `f64` (shortest round-trip form), in exponent notation

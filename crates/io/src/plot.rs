@@ -643,3 +643,101 @@ mod picture_check {
         .unwrap();
     }
 }
+
+/// One series of a [`bar_chart_png`]: a value per category and, optionally, an interval drawn as a
+/// whisker.
+#[derive(Clone, Debug)]
+pub struct Bars<'a> {
+    pub label: &'a str,
+    pub values: &'a [f64],
+    /// `(low, high)` per category, or empty for no whiskers.
+    pub intervals: &'a [(f64, f64)],
+}
+
+/// A grouped bar chart: one group per category (named under the axis), one bar per series, with
+/// optional interval whiskers; non-finite values are left out.
+pub fn bar_chart_png(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    categories: &[String],
+    series: &[Bars],
+) -> io::Result<()> {
+    ensure_font();
+    let n = categories.len().max(1);
+    let finite = series
+        .iter()
+        .flat_map(|s| s.values.iter().copied().chain(s.intervals.iter().flat_map(|&(a, b)| [a, b])))
+        .filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((0.0f64, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    let hi = if hi.is_finite() && hi > lo { hi } else { lo + 1.0 };
+    let pad = 0.06 * (hi - lo);
+    // Room under the zero line for the category names.
+    let (y0, y1) = (lo - 3.0 * pad, hi + pad);
+    let width = (160 * n as u32 + 200).clamp(700, 1600);
+    let root = BitMapBackend::new(path, (width, 620)).into_drawing_area();
+    let draw = || -> Result<(), String> {
+        let e = |e: DrawingAreaErrorKind<_>| e.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(14)
+            .x_label_area_size(10)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-0.5f64..n as f64 - 0.5, y0..y1)
+            .map_err(e)?;
+        let span = y1 - y0;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(0)
+            .y_desc(y_label)
+            .y_label_formatter(&|v| axis_tick_label(*v, span))
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 16))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(e)?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![(-0.5, 0.0), (n as f64 - 0.5, 0.0)], BLACK)))
+            .map_err(e)?;
+        let m = series.len().max(1) as f64;
+        let bar = 0.8 / m;
+        for (si, s) in series.iter().enumerate() {
+            let color = PALETTE[si % PALETTE.len()];
+            let x_of = |ci: usize| ci as f64 - 0.4 + bar * si as f64;
+            let rects = s.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(ci, &v)| {
+                Rectangle::new([(x_of(ci) + 0.05 * bar, 0.0), (x_of(ci) + 0.95 * bar, v)], color.filled())
+            });
+            let anno = chart.draw_series(rects).map_err(e)?;
+            anno.label(s.label)
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], color.filled()));
+            let whiskers =
+                s.intervals.iter().enumerate().filter(|(_, (a, b))| a.is_finite() && b.is_finite()).map(
+                    |(ci, &(a, b))| {
+                        let xc = x_of(ci) + 0.5 * bar;
+                        PathElement::new(vec![(xc, a), (xc, b)], BLACK.stroke_width(2))
+                    },
+                );
+            chart.draw_series(whiskers).map_err(e)?;
+        }
+        let names = categories.iter().enumerate().map(|(ci, c)| {
+            Text::new(
+                c.clone(),
+                (ci as f64, lo - 1.5 * pad),
+                TextStyle::from(("sans-serif", 14).into_font()).pos(Pos::new(HPos::Center, VPos::Center)),
+            )
+        });
+        chart.draw_series(names).map_err(e)?;
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+        root.present().map_err(e)
+    };
+    draw().map_err(|m| err(path, m))
+}

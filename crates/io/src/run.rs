@@ -3,6 +3,8 @@
 //! A run writes one folder: `run.toml` (the fully resolved input), `log.txt`, CSV time series, VTU/PVD
 //! snapshots, pictures, and `checkpoint.bin` while it is unfinished.
 
+use crate::checkpoint::CheckpointError;
+use serde::{de::DeserializeOwned, Serialize};
 use spatter_core::control::{Finished, RunControl};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -54,10 +56,37 @@ impl RunDir {
 pub struct RunContext<'a> {
     /// Where outputs go.
     pub dir: &'a RunDir,
-    /// Stop requests (Ctrl-C) and progress reporting.
+    /// Stop requests (Ctrl-C, SIGTERM), periodic checkpoint requests and progress reporting.
     pub control: &'a dyn RunControl,
     /// Continue from `dir/checkpoint.bin` instead of starting afresh.
     pub resume: bool,
+    /// Hash of the resolved input ([`crate::checkpoint::fnv1a`] of `run.toml`), stamped into every
+    /// checkpoint and checked on resume; 0 when the job runs without an input file (library use).
+    pub input_hash: u64,
+}
+
+impl<'a> RunContext<'a> {
+    /// A context without an input hash (checkpoints are not stamped, any checkpoint is accepted).
+    pub fn new(dir: &'a RunDir, control: &'a dyn RunControl, resume: bool) -> Self {
+        RunContext { dir, control, resume, input_hash: 0 }
+    }
+
+    /// Writes `state` to `dir/checkpoint.bin` atomically, stamped with [`RunContext::input_hash`].
+    pub fn save_checkpoint<T: Serialize>(&self, state: &T) -> Result<(), CheckpointError> {
+        crate::checkpoint::save(&self.dir.checkpoint_path(), self.input_hash, state)?;
+        tracing::debug!("checkpoint written to {}", self.dir.checkpoint_path().display());
+        Ok(())
+    }
+
+    /// Reads `dir/checkpoint.bin`, refusing a damaged one, another format or another input.
+    pub fn load_checkpoint<T: DeserializeOwned>(&self) -> Result<T, CheckpointError> {
+        crate::checkpoint::load(&self.dir.checkpoint_path(), self.input_hash)
+    }
+
+    /// True when the job should write a checkpoint now and carry on (periodic checkpoints).
+    pub fn checkpoint_due(&self) -> bool {
+        self.control.checkpoint_due()
+    }
 }
 
 /// What a job tells the user when it returns.
@@ -82,4 +111,12 @@ impl RunSummary {
     pub fn scalar(&mut self, name: &str, value: f64) {
         self.scalars.push((name.to_owned(), value));
     }
+}
+
+/// A reduced-size variant of a job's configuration (`spatter run --smoke`): the same scenario cut to a
+/// few steps, parcels or impacts, so that it runs to the end in seconds and still writes every output.
+/// CI runs every example this way; the resolved input (`run.toml`) shows the reduced values.
+pub trait Smoke {
+    /// Shrinks the run in place.
+    fn smoke(&mut self);
 }

@@ -40,6 +40,11 @@ macro_rules! kinds {
                 match *self { $( Scenario::$variant(ref c) => $run(c, ctx).map_err(|e| Box::new(e) as RunError), )* }
             }
 
+            /// Cuts the scenario down to a smoke test (see [`spatter_io::run::Smoke`]).
+            pub fn smoke(&mut self) {
+                match *self { $( Scenario::$variant(ref mut c) => spatter_io::run::Smoke::smoke(c), )* }
+            }
+
             /// The fully resolved input as TOML (`kind` first, every default filled in).
             pub fn resolved_toml(&self) -> Result<String, String> {
                 match *self { $( Scenario::$variant(ref c) => resolved($name, c), )* }
@@ -63,9 +68,9 @@ macro_rules! kinds {
 }
 
 kinds! {
-    "dem" => Dem(spatter_dem::SceneConfig, spatter_dem::run),
+    "dem" => Dem(spatter_workflows::dem_scene::SceneConfig, spatter_workflows::dem_scene::run),
         "A DEM scene: materials, particles (fills, injectors), walls (planes, cylinders, STL meshes with motion).";
-    "sph" => Sph(spatter_sph::scene::SphConfig, spatter_sph::scene::run),
+    "sph" => Sph(spatter_workflows::sph_scene::SphConfig, spatter_workflows::sph_scene::run),
         "Free-surface water (WCSPH) with walls and moving bodies: wetting maps, splash heights, probes.";
     "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run),
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";

@@ -9,8 +9,10 @@
 //! * [`source`] — reading the file and locating byte offsets and key paths in it;
 //! * [`parse`] — typed deserialisation and validation with located errors;
 //! * [`paths`] — relative file paths made absolute against the scenario's folder;
-//! * [`kinds`] — the registry of scenario kinds.
+//! * [`kinds`] — the registry of scenario kinds;
+//! * [`job`] — the job driver: run folder, `run.toml`, log, checkpoints, finiteness check, `summary.json`.
 
+pub mod job;
 pub mod kinds;
 pub mod parse;
 pub mod paths;

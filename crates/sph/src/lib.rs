@@ -10,7 +10,7 @@
 //! * [`guard`] — no particle crosses a wall, however thin;
 //! * [`fill`] — fluid initialisation on a lattice (box minus solids, flood fill);
 //! * [`drag`] — air drag;
-//! * [`scene`] — the `sph` scenario kind: configuration, outputs, checkpoint/resume;
+//! * [`wetting`] — wetting maps and wet areas at wall-particle resolution;
 //! * [`sessile`] — contact angle of a sessile drop for a given adhesion (calibration);
 //! * [`validation`] — reference cases for `spatter validate`;
 //! * [`sim`] — the [`Simulation`] and its time step (velocity Verlet with one force evaluation per step).
@@ -30,10 +30,10 @@ pub mod kernel;
 pub mod neighbours;
 pub mod params;
 mod pass;
-pub mod scene;
 pub mod sessile;
 pub mod sim;
 pub mod validation;
+pub mod wetting;
 
 pub use error::SphError;
 pub use kernel::{Dim, KernelKind};

@@ -7,7 +7,7 @@ use spatter_core::Vec3;
 
 /// Adhesion factors `[low, high]` of walls for which `spatter sessile` resolves a contact angle (see
 /// [`SphParams::adhesion_note`] and docs/sph.md, "Sessile-drop calibration").
-pub const ADHESION_CALIBRATED: [f64; 2] = [0.5, 2.0];
+pub const ADHESION_CALIBRATED: [f64; 2] = [0.75, 3.0];
 
 /// Air drag on fluid particles (no equation in the thesis, digest §2.12; model choice in [`crate::drag`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -205,22 +205,24 @@ impl SphParams {
         10.0 * (p / self.rest_density).sqrt()
     }
 
-    /// Adhesion factors within which the sessile-drop calibration resolves a contact angle: below
-    /// [`ADHESION_CALIBRATED`]`[0]` a resting drop does not wet the wall (θ ≳ 100° in 2D, ≳ 130° in 3D, and
-    /// 180° — the drop leaves — a little lower); above [`ADHESION_CALIBRATED`]`[1]` the wall wets completely
-    /// (the drop spreads to a film one to three spacings thick, θ < 10° in 2D), so a larger factor changes
-    /// no angle, only how hard the film is pressed onto the wall. See [`SphParams::adhesion_note`].
+    /// Adhesion factors within which the sessile-drop calibration resolves a contact angle: at and below
+    /// 0.5 a resting drop does not wet the wall (180°: it balls up), so below
+    /// [`ADHESION_CALIBRATED`]`[0]` the angle is not resolved; above [`ADHESION_CALIBRATED`]`[1]` the wall
+    /// wets completely (the drop spreads to a film one to three spacings thick, θ below about 8° in 2D and
+    /// 13° in 3D), so a larger factor changes the angle little and mostly presses the film harder onto the
+    /// wall. See [`SphParams::adhesion_note`] and the tables of docs/sph.md.
     pub fn adhesion_note(adhesion: f64) -> Option<String> {
         let [lo, hi] = ADHESION_CALIBRATED;
         if adhesion > 0.0 && adhesion < lo {
             Some(format!(
-                "adhesion {adhesion} is below the calibrated range {lo}–{hi}: a resting drop does not wet such a wall \
-                 (contact angle above about 100°), and factors this low differ little from 0"
+                "adhesion {adhesion} is below the calibrated range {lo}–{hi}: a resting drop wets such a wall little \
+                 or not at all (contact angle above about 70° in 2D and 120° in 3D, 180° from 0.5 down)"
             ))
         } else if adhesion > hi {
             Some(format!(
                 "adhesion {adhesion} is above the calibrated range {lo}–{hi}: the wall already wets completely \
-                 (contact angle below about 10°); a larger factor only presses the water film harder onto the wall"
+                 (contact angle below about 8° in 2D and 13° in 3D); a larger factor mostly presses the water film \
+                 harder onto the wall"
             ))
         } else {
             None

@@ -160,7 +160,7 @@ pub fn submerged_solid(quick: bool) -> Vec<Check> {
         sim.step().expect("validation case runs without blow-up");
         steps += 1;
         if steps == 1 {
-            let w = crate::scene::wetting::wet_area(&sim, k, sim.time);
+            let w = crate::wetting::wet_area(&sim, k, sim.time);
             dry_after_first = (w.area - w.wet_now) / w.area;
         }
         if sim.time >= from {
@@ -168,7 +168,7 @@ pub fn submerged_solid(quick: bool) -> Vec<Check> {
             n += 1;
         }
     }
-    let w = crate::scene::wetting::wet_area(&sim, k, sim.time);
+    let w = crate::wetting::wet_area(&sim, k, sim.time);
     let window = if quick { "first 150 steps" } else { "0.2–0.4 s" };
     vec![
         Check::relative(
@@ -228,7 +228,7 @@ pub fn hydrostatic_tank(quick: bool) -> Vec<Check> {
         }
     });
     let mut checks = Vec::new();
-    let src = "hydrostatics p = ρ g z (VERIFICATION.md, SPH)";
+    let src = "hydrostatics p = ρ g z";
     for frac in [0.25, 0.5, 0.75] {
         let z = depth * (1.0 - frac);
         let x = Vec3::new(0.5 * width, 0.5 * ly, z);

@@ -4,8 +4,8 @@
 use spatter_core::mesh::TriMesh;
 use spatter_core::{Aabb, Vec3};
 use spatter_sph::boundary::Sampling;
-use spatter_sph::scene::wetting::{wet_area, wetting_map};
 use spatter_sph::sim::WallOptions;
+use spatter_sph::wetting::{wet_area, wetting_map};
 use spatter_sph::{Dim, Simulation, SphParams};
 
 const OPEN_TOP: [bool; 6] = [true, true, true, true, true, false];

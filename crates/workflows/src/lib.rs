@@ -1,5 +1,7 @@
 //! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
 
+pub mod dem_scene;
 pub mod deposition;
 pub mod snow;
+pub mod sph_scene;
 pub mod wading;

@@ -2,6 +2,7 @@
 
 pub mod run;
 pub mod sessile;
+pub mod sweep;
 
 use crate::registry;
 use anyhow::Result;
@@ -131,7 +132,7 @@ pub fn forces(path: &Path, out: Option<&Path>) -> Result<ExitCode> {
         return Ok(ExitCode::from(EXIT_BAD_INPUT));
     };
     // The run prints the ranking table (its headline) and writes the CSV tables.
-    run::run_file(path, out, None, false)
+    run::run_file(path, &run::RunArgs { out: out.map(Path::to_owned), ..run::RunArgs::default() })
 }
 
 /// `spatter bench <engine>`.

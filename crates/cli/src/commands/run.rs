@@ -1,10 +1,11 @@
-//! `spatter run` and `spatter demo`.
+//! `spatter run` and `spatter demo`: argument handling around the job driver
+//! ([`spatter_scenario::job`]), which does the rest.
 
 use super::{report_errors, EXIT_BAD_INPUT};
-use crate::control::{install_ctrlc, CliControl};
+use crate::control::{install_signal_handler, CliControl};
 use anyhow::{Context, Result};
 use spatter_core::control::Finished;
-use spatter_io::run::{RunContext, RunDir};
+use spatter_scenario::job::{self, JobError, JobOptions};
 use spatter_scenario::Loaded;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -13,21 +14,60 @@ use std::time::Instant;
 /// The built-in scenario `spatter demo` runs (the same text as the example file).
 pub const DEMO_SCENARIO: (&str, &str) = crate::registry::DEMO_SCENARIO;
 
+/// Exit code of a run stopped by a signal (checkpoint written): 128 + SIGINT, as shells report it.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Largest `--threads` accepted, as a multiple of the logical CPUs.
+const THREADS_PER_CPU_MAX: usize = 4;
+
+/// What `spatter run` was asked to do besides the scenario.
+#[derive(Clone, Debug)]
+pub struct RunArgs {
+    pub out: Option<PathBuf>,
+    pub threads: Option<usize>,
+    pub resume: bool,
+    pub overwrite: bool,
+    pub checkpoint_interval_s: f64,
+    pub verbose: u8,
+    pub quiet: bool,
+    /// Cut the scenario down to a smoke test (`--smoke`).
+    pub smoke: bool,
+}
+
+impl Default for RunArgs {
+    fn default() -> Self {
+        RunArgs {
+            out: None,
+            threads: None,
+            resume: false,
+            overwrite: false,
+            checkpoint_interval_s: job::DEFAULT_CHECKPOINT_INTERVAL_S,
+            verbose: 0,
+            quiet: false,
+            smoke: false,
+        }
+    }
+}
+
 /// `spatter run <scenario>`.
-pub fn run_file(path: &Path, out: Option<&Path>, threads: Option<usize>, resume: bool) -> Result<ExitCode> {
-    let loaded = match spatter_scenario::load(path) {
+pub fn run_file(path: &Path, args: &RunArgs) -> Result<ExitCode> {
+    let mut loaded = match spatter_scenario::load(path) {
         Ok(l) => l,
         Err(errors) => {
             report_errors(&errors);
             return Ok(ExitCode::from(EXIT_BAD_INPUT));
         }
     };
-    let out = out.map(Path::to_owned).unwrap_or_else(|| default_out(path));
+    if args.smoke {
+        loaded.scenario.smoke();
+        eprintln!("note: --smoke: a reduced run of {} (see run.toml for the values used)", path.display());
+    }
+    let out = args.out.clone().unwrap_or_else(|| default_out(path));
     let again = format!("spatter run {} --out {} --resume", path.display(), out.display());
-    execute(loaded, &out, threads, resume, &again)
+    execute(loaded, &out, args, &again)
 }
 
-/// `spatter demo`.
+/// `spatter demo`: the built-in scenario; an earlier demo in the same folder is replaced.
 pub fn demo(out: &Path, threads: Option<usize>) -> Result<ExitCode> {
     let (name, text) = DEMO_SCENARIO;
     let loaded = spatter_scenario::load_str(Path::new(name), text).map_err(|errors| {
@@ -37,7 +77,8 @@ pub fn demo(out: &Path, threads: Option<usize>) -> Result<ExitCode> {
         )
     })?;
     println!("spatter demo: running the built-in scenario `{name}` ({})", loaded.scenario.kind());
-    execute(loaded, out, threads, false, &format!("spatter run {name} --out {} --resume", out.display()))
+    let args = RunArgs { threads, overwrite: true, ..RunArgs::default() };
+    execute(loaded, out, &args, &format!("spatter run {name} --out {} --resume", out.display()))
 }
 
 fn default_out(scenario: &Path) -> PathBuf {
@@ -45,70 +86,59 @@ fn default_out(scenario: &Path) -> PathBuf {
     PathBuf::from("runs").join(stem)
 }
 
-fn execute(
-    loaded: Loaded,
-    out: &Path,
-    threads: Option<usize>,
-    resume: bool,
-    resume_hint: &str,
-) -> Result<ExitCode> {
-    if let Some(n) = threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot set up worker threads")?;
-    }
-    let dir = RunDir::create(out)?;
-    let checkpoint = dir.checkpoint_path();
-    if resume && !checkpoint.is_file() {
-        anyhow::bail!(
-            "--resume: {} holds no checkpoint.bin; run without --resume to start afresh",
-            out.display()
-        );
-    }
-    if !resume && checkpoint.is_file() {
-        eprintln!(
-            "note: {} holds a checkpoint of an unfinished run; starting afresh (use --resume to continue it)",
-            out.display()
-        );
-        std::fs::remove_file(&checkpoint).ok();
-    }
-    let resolved = loaded.scenario.resolved_toml().map_err(anyhow::Error::msg)?;
-    if !resume {
-        std::fs::remove_file(dir.root().join("log.txt")).ok();
-    }
-    dir.write_text("run.toml", &resolved)?;
-
-    install_ctrlc();
-    let control = CliControl::new();
-    crate::logging::init(Some(&dir.root().join("log.txt")), control.bar())?;
-    tracing::info!(
-        "spatter {} {} scenario {} → {}{}",
-        env!("CARGO_PKG_VERSION"),
-        loaded.scenario.kind(),
-        loaded.source.path.display(),
-        out.display(),
-        if resume { " (resumed)" } else { "" }
+/// Sets up the global thread pool (`--threads`; all cores when `None`): refused when 0 or beyond
+/// [`THREADS_PER_CPU_MAX`] per logical CPU.
+pub fn set_threads(threads: Option<usize>) -> Result<()> {
+    let Some(n) = threads else { return Ok(()) };
+    let cpus = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    anyhow::ensure!(n >= 1, "--threads 0: expected at least 1 worker thread");
+    anyhow::ensure!(
+        n <= THREADS_PER_CPU_MAX * cpus,
+        "--threads {n}: this machine has {cpus} logical CPUs; expected at most {} ({}× the CPUs), more \
+         threads only slow the run down",
+        THREADS_PER_CPU_MAX * cpus,
+        THREADS_PER_CPU_MAX
     );
-    tracing::info!("threads: {}", rayon::current_num_threads());
-    let ctx = RunContext { dir: &dir, control: &control, resume };
-    let started = Instant::now();
-    let result = loaded.scenario.run(&ctx);
-    control.finish();
-    let summary = result.map_err(|e| anyhow::anyhow!("{e}"))?;
-    let secs = started.elapsed().as_secs_f64();
-    for line in &summary.headline {
-        println!("{line}");
-        tracing::info!("{line}");
+    rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("cannot set up worker threads")
+}
+
+fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Result<ExitCode> {
+    set_threads(args.threads)?;
+    install_signal_handler();
+    let control = CliControl::new(args.quiet);
+    if let Some(note) = crate::logging::init(control.bar(), args.verbose, args.quiet) {
+        eprintln!("note: {note}");
     }
-    for (label, path) in &summary.artifacts {
-        println!("  {label}: {}", path.display());
+    let opts = JobOptions {
+        out: out.to_owned(),
+        resume: args.resume,
+        overwrite: args.overwrite,
+        checkpoint_interval_s: args.checkpoint_interval_s,
+        keep: Vec::new(),
+    };
+    let started = Instant::now();
+    let result = job::run(&loaded, &opts, &control);
+    control.finish();
+    let summary = match result {
+        Ok(s) => s,
+        Err(e @ (JobError::Folder(_) | JobError::Resume(_))) => {
+            eprintln!("error: {e}");
+            return Ok(ExitCode::from(EXIT_BAD_INPUT));
+        }
+        Err(e) => return Err(anyhow::anyhow!("{e}")),
+    };
+    let secs = started.elapsed().as_secs_f64();
+    if !args.quiet {
+        for line in &summary.headline {
+            println!("{line}");
+        }
+        for (label, path) in &summary.artifacts {
+            println!("  {label}: {}", path.display());
+        }
     }
     match summary.finished {
         Finished::Completed => {
             println!("done in {secs:.1} s; results in {}", out.display());
-            tracing::info!("completed in {secs:.3} s");
             Ok(ExitCode::SUCCESS)
         }
         Finished::Interrupted => {
@@ -116,8 +146,7 @@ fn execute(
                 "stopped after {secs:.1} s; outputs so far are in {}. Continue with:\n  {resume_hint}",
                 out.display()
             );
-            tracing::info!("interrupted after {secs:.3} s; checkpoint written");
-            Ok(ExitCode::from(130))
+            Ok(ExitCode::from(EXIT_INTERRUPTED))
         }
     }
 }

@@ -14,7 +14,7 @@
 //! engine calls once per contact. The engine is generic over its `ContactLaw`, so the whole per-contact
 //! computation is monomorphised and inlined: no `dyn` call per contact. Where a scenario file picks laws at
 //! run time, the scene runner `match`es once on the choice and instantiates the engine for that
-//! combination (see [`crate::scene`]).
+//! combination (see `spatter_workflows::dem_scene`).
 //!
 //! Each sub-law turns the pair's [`PairProps`] (E*, G*, μ, μ_r, e, Γ … of material a × material b) into its
 //! own precomputed `Params` once per pair type ([`ContactLaw::params`]); the per-contact call only reads

@@ -13,7 +13,7 @@ use spatter_core::material::Material;
 use spatter_core::validation::Check;
 use spatter_core::Vec3;
 
-const SRC: &str = "Chung & Ooi (2011) Granular Matter 13:643, VERIFICATION.md";
+const SRC: &str = "Chung & Ooi (2011) Granular Matter 13:643";
 
 fn mat(e: f64, nu: f64, rho: f64) -> Material {
     Material { youngs_modulus: e, poisson_ratio: nu, density: rho }

@@ -377,10 +377,10 @@ fn a_contact_sliding_across_a_seam_through_rebuilds_and_a_checkpoint_is_one_impa
         let mut sim = resting_slider(law.clone(), dir.path());
         sim.run_steps(3750).unwrap();
         let path = dir.path().join("checkpoint.bin");
-        spatter_io::checkpoint::save(&path, &sim.state()).unwrap();
+        spatter_io::checkpoint::save(&path, 0, &sim.state()).unwrap();
         sim.run_steps(3750).unwrap();
         let mut resumed = resting_slider(law, dir.path());
-        resumed.restore(spatter_io::checkpoint::load(&path).unwrap()).unwrap();
+        resumed.restore(spatter_io::checkpoint::load(&path, 0).unwrap()).unwrap();
         resumed.run_steps(3750).unwrap();
         for (run, s) in [("uninterrupted", &sim), ("resumed", &resumed)] {
             assert!(

@@ -80,7 +80,12 @@ impl Validate for WallRuleSpec {
         match self {
             WallRuleSpec::Reflect { restitution } => c.item("restitution", restitution),
             WallRuleSpec::RegimeMap { file, bounce, max_tangential_speed_m_s, max_wall_shear_pa } => {
-                c.file_exists("file", file);
+                let full = c.resolve(file);
+                if !full.is_file() {
+                    c.file_exists("file", file);
+                } else if let Err(e) = load_regime_map(&full) {
+                    c.fail("file", format!("file = \"{}\": {e}", file.display()));
+                }
                 c.item("bounce", bounce);
                 if let Some(v) = max_tangential_speed_m_s {
                     c.non_negative("max_tangential_speed_m_s", *v);
@@ -118,6 +123,18 @@ pub enum WallRuleError {
     Format { path: PathBuf, message: String },
 }
 
+/// Reads and checks a regime-map JSON file: syntax (with line and column), schema tag and both fits (a
+/// reversed `x_range` or an empty coefficient list would make every impact panic or stick wrongly); the
+/// message names the file and the key.
+pub fn load_regime_map(path: &std::path::Path) -> Result<RegimeMap, WallRuleError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| WallRuleError::Io { path: path.to_owned(), source })?;
+    let map: RegimeMap = serde_json::from_str(&text)
+        .map_err(|e| WallRuleError::Format { path: path.to_owned(), message: e.to_string() })?;
+    map.check().map_err(|message| WallRuleError::Format { path: path.to_owned(), message })?;
+    Ok(map)
+}
+
 impl WallRule {
     /// Loads the rule, reading a regime map relative to `base` (the scenario's folder) when needed.
     pub fn from_spec(spec: &WallRuleSpec, base: Option<&std::path::Path>) -> Result<Self, WallRuleError> {
@@ -130,13 +147,7 @@ impl WallRule {
                     Some(b) if file.is_relative() => b.join(file),
                     _ => file.clone(),
                 };
-                let text = std::fs::read_to_string(&path)
-                    .map_err(|source| WallRuleError::Io { path: path.clone(), source })?;
-                let map: RegimeMap = serde_json::from_str(&text)
-                    .map_err(|e| WallRuleError::Format { path: path.clone(), message: e.to_string() })?;
-                // Schema tag and both fits (a reversed x_range or an empty coefficient list would make
-                // every impact panic or stick wrongly); the message names the key.
-                map.check().map_err(|message| WallRuleError::Format { path, message })?;
+                let map = load_regime_map(&path)?;
                 WallRule::RegimeMap {
                     map,
                     bounce: *bounce,

@@ -204,15 +204,27 @@ impl Validate for FlowSpec {
             );
         }
         if let Some(p) = &self.vtk {
-            c.file_exists("vtk", p);
+            vtk_file(c, "vtk", p);
         }
         if let Some(p) = &self.series {
-            c.file_exists("series", p);
+            let full = c.resolve(p);
+            if !full.is_file() {
+                c.file_exists("series", p);
+            } else {
+                match spatter_flow::vtk::series::read_series(&full) {
+                    Err(e) => c.fail("series", format!("series = \"{}\": {e}", p.display())),
+                    // The first snapshot is read in full; the others when the run reaches them.
+                    Ok(list) => match list.first() {
+                        None => c.fail("series", format!("series = \"{}\" lists no files", p.display())),
+                        Some((_, f)) => vtk_file(c, "series", f),
+                    },
+                }
+            }
         }
         for (i, f) in self.files.iter().enumerate() {
             c.element("files", i, |c| {
                 c.finite("time_s", f.time_s);
-                c.file_exists("file", &f.file);
+                vtk_file(c, "file", &f.file);
             });
         }
         for (i, a) in self.analytic.iter().enumerate() {
@@ -234,6 +246,22 @@ impl Validate for FlowSpec {
         if let Some(p) = self.period_s {
             c.positive("period_s", p);
         }
+    }
+}
+
+/// Memory per parcel for the size estimate \[B\] (tracker state, released parcels, deposit records, with
+/// margin).
+pub const BYTES_PER_PARCEL: u64 = 400;
+
+/// `path` must name a VTK file the flow reader accepts (legacy or XML, sizes consistent, coordinates
+/// finite); the message names the key and the file.
+fn vtk_file(c: &mut Checker, key: &str, path: &Path) {
+    let full = c.resolve(path);
+    if !full.is_file() {
+        return c.file_exists(key, path);
+    }
+    if let Err(e) = spatter_flow::vtk::read(&full) {
+        c.fail(key, format!("{key} = \"{}\": {e}", path.display()));
     }
 }
 
@@ -261,7 +289,7 @@ impl Validate for DepositionConfig {
                         ),
                     );
                 }
-                c.file_exists("file", &b.file);
+                c.mesh_file("file", &b.file);
                 c.positive("scale", b.scale);
                 c.finite_vec("translate_m", b.translate_m);
                 c.item("wall", &b.wall);
@@ -283,13 +311,28 @@ impl Validate for DepositionConfig {
             c.fail("injectors", "too many injectors");
         }
         for (i, inj) in self.injectors.iter().enumerate() {
-            c.element("injectors", i, |c| inj.validate(c));
+            c.element("injectors", i, |c| {
+                inj.validate(c);
+                c.memory_estimate(
+                    "parcels",
+                    &format!("parcels = {} × {BYTES_PER_PARCEL} B", inj.parcels),
+                    inj.parcels as f64 * BYTES_PER_PARCEL as f64,
+                );
+            });
         }
         c.nested("time", |c| {
             c.positive("dt_s", self.time.dt_s);
             c.positive("duration_s", self.time.duration_s);
             if self.time.duration_s / self.time.dt_s > 1e9 {
                 c.fail("dt_s", "more than 10⁹ steps: increase dt_s or shorten duration_s");
+            } else if self.time.dt_s > self.time.duration_s {
+                c.fail(
+                    "dt_s",
+                    format!(
+                        "dt_s = {} is longer than duration_s = {}: the run would take one step and deposit nothing",
+                        self.time.dt_s, self.time.duration_s
+                    ),
+                );
             }
         });
         if let Some(d) = &self.domain {
@@ -300,6 +343,30 @@ impl Validate for DepositionConfig {
                     c.fail("max_m", "max_m must exceed min_m in every component");
                 }
             });
+        }
+        // An injector that releases every parcel outside the domain does nothing (each parcel escapes at once).
+        if let Some(d) = &self.domain {
+            let inside = |p: &Vec3| p.cmpge(d.min_m).all() && p.cmple(d.max_m).all();
+            for (i, inj) in self.injectors.iter().enumerate() {
+                use spatter_flow::tracker::inject::Region;
+                let outside = match &inj.region {
+                    Region::Points { points_m } => !points_m.is_empty() && !points_m.iter().any(inside),
+                    Region::Box { min_m, max_m } => max_m.cmplt(d.min_m).any() || min_m.cmpgt(d.max_m).any(),
+                    Region::Surface { .. } => false,
+                };
+                if outside {
+                    c.element("injectors", i, |c| {
+                        c.fail(
+                            "region",
+                            format!(
+                                "the injection region of \"{}\" lies outside the domain [{}, {}]: every parcel \
+                                 would escape at once",
+                                inj.name, d.min_m, d.max_m
+                            ),
+                        )
+                    });
+                }
+            }
         }
         c.nested("output", |c| c.positive("interval_s", self.output.interval_s));
     }
@@ -359,4 +426,20 @@ impl Validate for ForcesConfig {
             }
         });
     }
+}
+
+impl spatter_io::run::Smoke for DepositionConfig {
+    /// At most 200 parcels per injector, 40 steps, an output every 10.
+    fn smoke(&mut self) {
+        for i in &mut self.injectors {
+            i.parcels = i.parcels.min(200);
+        }
+        self.time.duration_s = self.time.duration_s.min(40.0 * self.time.dt_s);
+        self.output.interval_s = self.output.interval_s.min(10.0 * self.time.dt_s);
+    }
+}
+
+impl spatter_io::run::Smoke for ForcesConfig {
+    /// A table of a few closed-form numbers is already quick.
+    fn smoke(&mut self) {}
 }

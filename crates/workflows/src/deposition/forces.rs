@@ -106,6 +106,12 @@ pub fn run(cfg: &ForcesConfig, ctx: &RunContext) -> Result<RunSummary, ForcesErr
     s.headline = report(cfg);
     s.artifacts.push(("reference magnitudes".into(), a));
     s.artifacts.push(("force library magnitudes / g".into(), b));
+    // The ranked numbers: each reference force per diameter (nondimensional, as in the table).
+    for row in &refs.rows {
+        for (d, v) in refs.diameters.iter().zip(&row.values) {
+            s.scalar(&format!("{}_at_{}um", row.symbol, spatter_io::fmt_f64(d * 1e6)), *v);
+        }
+    }
     Ok(s)
 }
 
@@ -130,7 +136,7 @@ mod tests {
     fn forces_run_writes_the_table() {
         let dir = tempfile::tempdir().unwrap();
         let rd = spatter_io::run::RunDir::create(dir.path()).unwrap();
-        let ctx = RunContext { dir: &rd, control: &spatter_core::control::Unattended, resume: false };
+        let ctx = RunContext::new(&rd, &spatter_core::control::Unattended, false);
         let s = run(&table_6_4(), &ctx).unwrap();
         let text = std::fs::read_to_string(dir.path().join("force_ranking.csv")).unwrap();
         // Table 6.4 drag reference for 10 µm: 2.202e-3 (digests/seed_003_brownout.md §6.2).
@@ -147,7 +153,7 @@ mod tests {
     fn forces_run_refuses_an_invalid_configuration() {
         let dir = tempfile::tempdir().unwrap();
         let rd = spatter_io::run::RunDir::create(dir.path()).unwrap();
-        let ctx = RunContext { dir: &rd, control: &spatter_core::control::Unattended, resume: false };
+        let ctx = RunContext::new(&rd, &spatter_core::control::Unattended, false);
         let mut cfg = table_6_4();
         cfg.velocity_scale = 0.0;
         let e = run(&cfg, &ctx).unwrap_err().to_string();

@@ -202,8 +202,7 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     let ckpt = ctx.dir.checkpoint_path();
     let mut next_output = 0u64;
     let (mut csv, mut pvd) = if ctx.resume && ckpt.is_file() {
-        let c: Checkpoint = spatter_io::checkpoint::load(&ckpt)
-            .map_err(|e| DepositionError::Checkpoint(format!("{}: {e}", ckpt.display())))?;
+        let c: Checkpoint = ctx.load_checkpoint().map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
         if c.config != config {
             return Err(DepositionError::Resume(format!(
                 "{} was written by a different configuration; start afresh without --resume",
@@ -241,7 +240,8 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     let mut finished = Finished::Completed;
     let mut last_written_step = u64::MAX;
     while tr.state.step < n_steps {
-        if ctx.control.stop_requested() {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
             csv.flush()?;
             let c = Checkpoint {
                 config: config.clone(),
@@ -250,10 +250,11 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
                 next_output,
                 csv_bytes: csv.bytes_written(),
             };
-            spatter_io::checkpoint::save(&ckpt, &c)
-                .map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
-            finished = Finished::Interrupted;
-            break;
+            ctx.save_checkpoint(&c).map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
+            if stop {
+                finished = Finished::Interrupted;
+                break;
+            }
         }
         let t_end = tr.state.time + dt;
         for (i, inj) in injectors.iter_mut().enumerate() {
@@ -318,8 +319,21 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
         tr.airborne_mass().value(),
         inj - rhs
     );
-    tracing::info!("{line}");
     summary.headline.insert(0, line);
+    for (name, value) in [
+        ("t_end_s", tr.state.time),
+        ("injected_parcels", b.n_injected as f64),
+        ("injected_kg", inj),
+        ("deposited_parcels", b.n_deposited as f64),
+        ("deposited_kg", b.deposited.value()),
+        ("escaped_parcels", b.n_escaped as f64),
+        ("escaped_kg", b.escaped.value()),
+        ("airborne_parcels", tr.airborne() as f64),
+        ("airborne_kg", tr.airborne_mass().value()),
+        ("mass_balance_residual_kg", inj - rhs),
+    ] {
+        summary.scalar(name, value);
+    }
     let _ = std::fs::remove_file(&ckpt);
     Ok(summary)
 }
@@ -377,6 +391,10 @@ fn write_bodies(
             "{}: deposited {:.4e} kg on {:.4e} m² ({} impacts), peak {:.4e} kg/m²{partial_note}",
             body.name, mass, area, impacts, peak
         ));
+        summary.scalar(&format!("{}_deposited_kg", body.name), mass);
+        summary.scalar(&format!("{}_impacts", body.name), impacts as f64);
+        summary.scalar(&format!("{}_mean_mass_per_area_kg_m2", body.name), mass / area);
+        summary.scalar(&format!("{}_peak_mass_per_area_kg_m2", body.name), peak);
         rows.push(vec![
             body.name.clone(),
             spatter_io::fmt_f64(mass),

@@ -91,7 +91,7 @@ fn run_in(
     resume: bool,
 ) -> spatter_io::run::RunSummary {
     let rd = RunDir::create(out).unwrap();
-    let ctx = RunContext { dir: &rd, control, resume };
+    let ctx = RunContext::new(&rd, control, resume);
     run(cfg, &ctx).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -112,7 +112,7 @@ fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
     // deposited mass of the balance (1e-12 relative) and its impacts to the deposit's impact count.
     assert!(b.join("plate_deposit.png").is_file() && b.join("deposit_summary.csv").is_file());
     assert!(s.headline.iter().any(|l| l.contains("PARTIAL") && l.contains("--resume")), "{:?}", s.headline);
-    let ck: super::run::Checkpoint = spatter_io::checkpoint::load(&b.join("checkpoint.bin")).unwrap();
+    let ck: super::run::Checkpoint = spatter_io::checkpoint::load(&b.join("checkpoint.bin"), 0).unwrap();
     let vtu = spatter_io::vtu::read(&b.join("bodies/plate.vtu")).unwrap();
     let partial_mass: f64 = vtu.cell_data["deposited_mass_kg"].1.iter().sum();
     let exact = ck.state.balance.deposited.value();
@@ -167,7 +167,7 @@ fn resuming_with_another_configuration_is_refused() {
     let mut other = cfg.clone();
     other.time.dt_s = 2.5e-4;
     let rd = RunDir::create(&out).unwrap();
-    let ctx = RunContext { dir: &rd, control: &Unattended, resume: true };
+    let ctx = RunContext::new(&rd, &Unattended, true);
     let e = run(&other, &ctx).unwrap_err().to_string();
     assert!(e.contains("checkpoint.bin") && e.contains("different configuration"), "{e}");
     // The checkpoint is left for the right configuration.
@@ -183,7 +183,7 @@ fn a_rust_caller_gets_the_validation_too() {
     let mut cfg = scenario(dir.path());
     cfg.time.dt_s = 0.0;
     let rd = RunDir::create(&dir.path().join("run")).unwrap();
-    let ctx = RunContext { dir: &rd, control: &Unattended, resume: false };
+    let ctx = RunContext::new(&rd, &Unattended, false);
     let e = run(&cfg, &ctx).unwrap_err();
     assert!(matches!(e, super::DepositionError::Invalid(_)), "{e}");
     assert!(e.to_string().contains("dt_s = 0 must be a positive number (time.dt_s)"), "{e}");

@@ -8,10 +8,11 @@
 
 use super::bed_index::BedIndex;
 use super::bisection::critical_speed;
+use super::cases::model_of;
 use super::config::SnowConfig;
 use super::model::Surface;
 use super::regime::{grid_jobs, run_job, stick_count};
-use super::runner::{aim_point, make_bed, model_of};
+use super::runner::{aim_point, make_bed};
 use rayon::prelude::*;
 use std::time::Instant;
 

@@ -160,12 +160,26 @@ impl Default for IntegrationConfig {
     }
 }
 
+/// Largest accepted `steps_per_contact`: a run polls for a stop between impacts, so one impact must stay
+/// short; 1e6 steps per Hertz time is far beyond where the integration error stops changing.
+pub const MAX_STEPS_PER_CONTACT: f64 = 1e6;
+
 impl Validate for IntegrationConfig {
     fn validate(&self, c: &mut Checker) {
         if !(self.steps_per_contact.is_finite() && self.steps_per_contact >= 10.0) {
             c.fail(
                 "steps_per_contact",
                 format!("steps_per_contact = {} must be at least 10", self.steps_per_contact),
+            );
+        } else if self.steps_per_contact > MAX_STEPS_PER_CONTACT {
+            c.fail(
+                "steps_per_contact",
+                format!(
+                    "steps_per_contact = {} is above {MAX_STEPS_PER_CONTACT:e}: one impact would take hours and \
+                     could not be stopped between impacts (the integration error is at round-off level from \
+                     about 1e4 steps per contact)",
+                    self.steps_per_contact
+                ),
             );
         }
         if let Some(dt) = self.dt_s {
@@ -281,10 +295,24 @@ impl GridConfig {
     }
 }
 
+/// Accepted particle and bed-sphere diameters \[m\]: from 1 nm (below it the continuum contact laws do not
+/// apply, and the impact arithmetic loses its meaning — 1e-300 m gave NaN rebound speeds) to 10 cm.
+pub const DIAMETER_RANGE_M: (f64, f64) = (1e-9, 0.1);
+
+/// `d` must be a diameter in [`DIAMETER_RANGE_M`].
+fn grain_diameter(c: &mut Checker, key: &str, d: f64) {
+    let (lo, hi) = DIAMETER_RANGE_M;
+    if d.is_nan() || d <= 0.0 {
+        c.positive(key, d);
+    } else if !(lo..=hi).contains(&d) {
+        c.fail(key, format!("{key} = {d} must be a diameter between {lo:e} and {hi:e} m"));
+    }
+}
+
 impl Validate for GridConfig {
     fn validate(&self, c: &mut Checker) {
-        c.positive("diameter_min_m", self.diameter_min_m);
-        c.positive("diameter_max_m", self.diameter_max_m);
+        grain_diameter(c, "diameter_min_m", self.diameter_min_m);
+        grain_diameter(c, "diameter_max_m", self.diameter_max_m);
         if self.diameter_max_m < self.diameter_min_m {
             c.fail(
                 "diameter_max_m",
@@ -582,8 +610,8 @@ impl RoughWallConfig {
 
 impl Validate for RoughWallConfig {
     fn validate(&self, c: &mut Checker) {
-        c.positive("particle_diameter_m", self.particle_diameter_m);
-        c.positive("bed_sphere_diameter_m", self.bed_sphere_diameter_m);
+        grain_diameter(c, "particle_diameter_m", self.particle_diameter_m);
+        grain_diameter(c, "bed_sphere_diameter_m", self.bed_sphere_diameter_m);
         c.in_range("volume_fraction", self.volume_fraction, 0.0, false, 2.0, true);
         if let Some(v) = self.bed_thickness_m {
             c.positive("bed_thickness_m", v);
@@ -659,7 +687,7 @@ impl Default for SingleConfig {
 
 impl Validate for SingleConfig {
     fn validate(&self, c: &mut Checker) {
-        c.positive("diameter_m", self.diameter_m);
+        grain_diameter(c, "diameter_m", self.diameter_m);
         c.positive("normal_speed_m_s", self.normal_speed_m_s);
         c.non_negative("tangential_speed_m_s", self.tangential_speed_m_s);
     }
@@ -763,69 +791,14 @@ impl Default for SnowConfig {
     }
 }
 
-impl Validate for SnowConfig {
-    fn validate(&self, c: &mut Checker) {
-        c.item("particle", &self.particle);
-        if self.particle.youngs_modulus.is_infinite() {
-            c.fail("particle.youngs_modulus_pa", "the particle must have a finite Young's modulus");
-        }
-        if let Some(t) = self.ice_temperature_c {
-            c.in_range(
-                "ice_temperature_c",
-                t,
-                ICE_TEMPERATURE_RANGE_C.0,
-                true,
-                ICE_TEMPERATURE_RANGE_C.1,
-                true,
-            );
-        }
-        c.item("wall", &self.wall);
-        if let Some(d) = self.partner_diameter_m {
-            c.positive("partner_diameter_m", d);
-        }
-        c.item("contact", &self.contact);
-        c.item("integration", &self.integration);
-        c.item("grid", &self.grid);
-        c.item("bisection", &self.bisection);
-        c.item("fit", &self.fit);
-        c.item("sensitivity", &self.sensitivity);
-        c.item("rough_wall", &self.rough_wall);
-        // The rough-wall speed defaults follow the grid's velocity scale, so the order is checked here.
-        let (lo, hi) = self.rough_wall.speed_range(self.grid.velocity_scale_m_s);
-        if lo > hi {
-            let key = if self.rough_wall.normal_speed_min_m_s.is_some() {
-                "rough_wall.normal_speed_min_m_s"
-            } else {
-                "rough_wall.normal_speed_max_m_s"
-            };
-            c.fail(key, format!("rough-wall speed range is inverted: normal_speed_min_m_s = {lo} is above normal_speed_max_m_s = {hi}"));
-        }
-        if self.mode == Mode::Sensitivity {
-            let jobs = self.grid.jobs().saturating_mul(self.sensitivity.cases.len() as u64);
-            if jobs > MAX_IMPACTS {
-                c.fail(
-                    "sensitivity.cases",
-                    format!(
-                        "{} cases × {} grid impacts = {jobs} impacts is above the cap of {MAX_IMPACTS} impacts per run",
-                        self.sensitivity.cases.len(),
-                        self.grid.jobs()
-                    ),
-                );
-            }
-        }
-        c.item("single", &self.single);
-        // A fixed time step above 1/8 of the shortest Hertz time of the run is refused (snow::dt_guard);
-        // checked only when everything else is valid, since the Hertz times need valid values.
-        if let Some(dt) = self.integration.dt_s {
-            if dt.is_finite() && dt > 0.0 {
-                let mut rest = self.clone();
-                rest.integration.dt_s = None;
-                if Checker::run(&rest, None).is_ok() {
-                    if let Some(msg) = super::dt_guard::refusal(self) {
-                        c.nested("integration", |c| c.fail("dt_s", msg));
-                    }
-                }
-            }
-        }
+impl spatter_io::run::Smoke for SnowConfig {
+    /// A 6 × 5 grid (bisection and sensitivity work on its diameters and speeds), a coarse bisection
+    /// tolerance, and 3 speeds × 3 impacts on the rough wall.
+    fn smoke(&mut self) {
+        self.grid.diameters = self.grid.diameters.min(6);
+        self.grid.normal_speeds = self.grid.normal_speeds.min(5);
+        self.bisection.relative_tolerance = self.bisection.relative_tolerance.max(0.05);
+        self.rough_wall.normal_speeds = self.rough_wall.normal_speeds.min(3);
+        self.rough_wall.impacts_per_speed = self.rough_wall.impacts_per_speed.min(3);
     }
 }

@@ -22,9 +22,9 @@
 //! ones; the guard uses t_H.
 
 use super::bed_index::BedIndex;
+use super::cases::{case_config, model_of};
 use super::config::{Mode, SnowConfig};
 use super::model::Surface;
-use super::runner::{case_config, model_of};
 
 /// Fraction of the shortest Hertz time above which a run is warned about (1/20).
 pub const DT_WARN_FRACTION: f64 = 0.05;

@@ -3,8 +3,11 @@
 pub mod bed;
 pub mod bed_index;
 pub mod bisection;
+pub mod cases;
+pub mod checks;
 pub mod config;
 pub mod dt_guard;
+pub mod error;
 pub mod fit;
 pub mod impact;
 pub mod material;
@@ -15,7 +18,8 @@ pub mod runner;
 pub mod samples;
 
 pub use config::SnowConfig;
-pub use runner::{run, SnowError};
+pub use error::SnowError;
+pub use runner::run;
 pub mod bench;
 pub mod validation;
 

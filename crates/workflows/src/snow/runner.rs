@@ -10,14 +10,16 @@
 use super::bed::{random_insertion, settled, wilson_interval, Bed};
 use super::bed_index::BedIndex;
 use super::bisection::{critical_speed, CriticalSpeed};
-use super::config::{Mode, Packing, SensitivityCase, SnowConfig};
+use super::cases::{case_config, model_of};
+use super::config::{Mode, Packing, SnowConfig};
+use super::error::SnowError;
 use super::material::TimeStepReport;
 use super::model::{ImpactModel, Surface};
 use super::output::{self, Axes, INTERFACE_RGB};
 use super::regime::{self, grid_jobs, run_job, ImpactRecord};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use spatter_core::check::{Checker, Invalid};
+use spatter_core::check::Checker;
 use spatter_core::control::Finished;
 use spatter_core::rng::{seeded, RngExt};
 use spatter_core::Vec3;
@@ -25,21 +27,6 @@ use spatter_dem::adhesion::tabor_parameter;
 use spatter_dem::restitution_models::RestitutionModel;
 use spatter_io::plot::Chart;
 use spatter_io::run::{RunContext, RunSummary};
-use std::io;
-use thiserror::Error;
-
-/// What can go wrong in a snow run.
-#[derive(Debug, Error)]
-pub enum SnowError {
-    #[error("invalid snow_regime_map configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
-    Invalid(Vec<Invalid>),
-    #[error("{0}")]
-    Io(#[from] io::Error),
-    #[error("checkpoint: {0}")]
-    Checkpoint(String),
-    #[error("cannot resume: {0}")]
-    Resume(String),
-}
 
 /// What `checkpoint.bin` holds.
 #[derive(Serialize, Deserialize)]
@@ -50,63 +37,30 @@ struct Progress {
     critical: Vec<CriticalSpeed>,
 }
 
-/// The impact model of `cfg` (baseline of the configuration).
-pub fn model_of(cfg: &SnowConfig) -> ImpactModel {
-    ImpactModel {
-        particle: cfg.particle.clone(),
-        wall: cfg.wall.clone(),
-        target: cfg.target,
-        partner_diameter: cfg.partner_diameter_m,
-        contact: cfg.contact.clone(),
-        integration: cfg.integration.clone(),
-    }
-}
-
-/// The configuration of sensitivity case `case`: the baseline with its values replaced.
-pub fn case_config(cfg: &SnowConfig, case: &SensitivityCase) -> SnowConfig {
-    let mut c = cfg.clone();
-    if let Some(e) = case.youngs_modulus_pa {
-        c.particle.youngs_modulus = e;
-    }
-    if let Some(nu) = case.poisson_ratio {
-        c.particle.poisson_ratio = nu;
-    }
-    if let Some(g) = case.work_of_adhesion_j_m2 {
-        c.contact.work_of_adhesion_j_m2 = g;
-    }
-    if let Some(sy) = case.yield_stress_pa {
-        c.contact.restitution = match c.contact.restitution {
-            RestitutionModel::Thornton { form, yield_geometry, .. } => {
-                RestitutionModel::Thornton { yield_stress_pa: sy, form, yield_geometry }
-            }
-            RestitutionModel::Constant { .. } => RestitutionModel::Thornton {
-                yield_stress_pa: sy,
-                form: Default::default(),
-                yield_geometry: Default::default(),
-            },
-        };
-    }
-    c
-}
-
-/// Does `jobs[done.len()..]` in chunks, polling for a stop between chunks.
+/// Does the jobs not yet in `done(p)` in chunks, polling between chunks for a stop (returns
+/// [`Finished::Interrupted`]) and for a periodic checkpoint (saves `p` and carries on).
 fn run_chunks<J: Sync, R: Send>(
     jobs: &[J],
-    done: &mut Vec<R>,
+    p: &mut Progress,
+    done: fn(&mut Progress) -> &mut Vec<R>,
     chunk: usize,
     ctx: &RunContext<'_>,
     f: impl Fn(&J) -> R + Sync,
-) -> Finished {
-    while done.len() < jobs.len() {
+) -> Result<Finished, SnowError> {
+    while done(p).len() < jobs.len() {
         if ctx.control.stop_requested() {
-            return Finished::Interrupted;
+            return Ok(Finished::Interrupted);
         }
-        let end = (done.len() + chunk).min(jobs.len());
-        let new: Vec<R> = jobs[done.len()..end].par_iter().map(&f).collect();
-        done.extend(new);
-        ctx.control.progress(done.len() as u64, jobs.len() as u64);
+        if ctx.checkpoint_due() {
+            save_progress(p, ctx)?;
+        }
+        let start = done(p).len();
+        let end = (start + chunk).min(jobs.len());
+        let new: Vec<R> = jobs[start..end].par_iter().map(&f).collect();
+        done(p).extend(new);
+        ctx.control.progress(end as u64, jobs.len() as u64);
     }
-    Finished::Completed
+    Ok(Finished::Completed)
 }
 
 fn config_json(cfg: &SnowConfig) -> String {
@@ -122,8 +76,7 @@ fn load_progress(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<Progress, Sno
     if !path.exists() {
         return Ok(fresh);
     }
-    let p: Progress = spatter_io::checkpoint::load(&path)
-        .map_err(|e| SnowError::Checkpoint(format!("{}: {e}", path.display())))?;
+    let p: Progress = ctx.load_checkpoint().map_err(|e| SnowError::Checkpoint(e.to_string()))?;
     if p.config != fresh.config {
         return Err(SnowError::Resume(format!(
             "{} was written by a different configuration; start afresh without --resume",
@@ -133,10 +86,13 @@ fn load_progress(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<Progress, Sno
     Ok(p)
 }
 
+fn save_progress(p: &Progress, ctx: &RunContext<'_>) -> Result<(), SnowError> {
+    ctx.save_checkpoint(p).map_err(|e| SnowError::Checkpoint(e.to_string()))
+}
+
 fn interrupted(p: &Progress, ctx: &RunContext<'_>, total: usize) -> Result<RunSummary, SnowError> {
     let path = ctx.dir.checkpoint_path();
-    spatter_io::checkpoint::save(&path, p)
-        .map_err(|e| SnowError::Checkpoint(format!("{}: {e}", path.display())))?;
+    save_progress(p, ctx)?;
     let mut s = RunSummary::new(Finished::Interrupted);
     s.headline.push(format!(
         "stopped after {} of {total} jobs; checkpoint written to {}",
@@ -302,6 +258,16 @@ fn boundary_deviation(points: &[[f64; 2]], base: &[[f64; 2]]) -> Option<f64> {
 /// Adds the energy check of `impacts` simulated impacts, `created` of which left with more kinetic energy
 /// than they came with (a numerical failure), to the summary; warns when there are any. `marked` names
 /// the file and column where they are flagged.
+/// Study scalars of a set of impacts: how many, the fraction that stuck, how many created energy.
+fn impact_scalars(s: &mut RunSummary, prefix: &str, records: &[ImpactRecord]) {
+    let n = records.len();
+    let stuck = records.iter().filter(|r| r.result.outcome == super::impact::Outcome::Stick).count();
+    s.scalar(&format!("{prefix}impacts"), n as f64);
+    s.scalar(&format!("{prefix}stick_fraction"), if n > 0 { stuck as f64 / n as f64 } else { 0.0 });
+    let created = records.iter().filter(|r| r.result.created_energy()).count();
+    s.scalar(&format!("{prefix}energy_created_impacts"), created as f64);
+}
+
 fn energy_check(s: &mut RunSummary, created: usize, impacts: usize, marked: &str) {
     if created == 0 && impacts == 1 {
         s.headline
@@ -351,7 +317,7 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
     let model = model_of(cfg);
     let mut p = load_progress(cfg, ctx)?;
     ctx.control.status("snow regime map: grid");
-    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, |j| run_job(&model, j))
+    if run_chunks(&jobs, &mut p, |p| &mut p.records, chunk_size(jobs.len()), ctx, |j| run_job(&model, j))?
         == Finished::Interrupted
     {
         return interrupted(&p, ctx, jobs.len());
@@ -363,6 +329,7 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
     s.artifacts.push(("every impact".into(), impacts));
     let created = p.records.iter().filter(|r| r.result.created_energy()).count();
     energy_check(&mut s, created, p.records.len(), "energy_created = 1 in impacts.csv");
+    s.scalar("energy_created_impacts", created as f64);
     let n_d = cfg.grid.diameters;
     let n_v = cfg.grid.normal_speeds;
     for (ai, angle) in cfg.grid.angles_deg.iter().enumerate() {
@@ -403,6 +370,12 @@ fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowEr
                     ctx.dir,
                 )?);
             }
+        }
+        if ai == 0 {
+            s.scalar("stick_count", regime::stick_count(recs) as f64);
+            s.scalar("impacts", recs.len() as f64);
+            s.scalar("stick_fraction", regime::stick_count(recs) as f64 / recs.len().max(1) as f64);
+            s.scalar("interface_diameters", iface.points.len() as f64);
         }
         let title = format!("Regime map, {} impacts at {angle} deg", recs.len());
         let chart = output::regime_chart(&title, recs, &points, map.as_ref().map(|m| &m.v_crit_of_d), &axes);
@@ -449,11 +422,12 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     let exp = cfg.bisection.max_expansions;
     if run_chunks(
         &ds,
-        &mut p.critical,
+        &mut p,
+        |p| &mut p.critical,
         chunk_size(ds.len()).min(4 * rayon::current_num_threads().max(1)),
         ctx,
         |&d| critical_speed(&model, d, lo, hi, tol, exp),
-    ) == Finished::Interrupted
+    )? == Finished::Interrupted
     {
         return interrupted(&p, ctx, ds.len());
     }
@@ -504,6 +478,22 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     // Speeds at or below the highest sticking speed of each diameter stick.
     let grid_count: usize = p.critical.iter().map(|c| vs.iter().filter(|&&v| v <= c.low).count()).sum();
     s.headline.push(format!("equivalent grid stick count ({} speeds): {grid_count}", vs.len()));
+    if let (Some(a), Some(b)) = (points.first(), points.last()) {
+        s.scalar("v_crit_smallest_d_m_s", a[1]);
+        s.scalar("v_crit_largest_d_m_s", b[1]);
+        let mean_log = points.iter().map(|q| q[1].ln()).sum::<f64>() / points.len() as f64;
+        s.scalar("v_crit_geometric_mean_m_s", mean_log.exp());
+    }
+    s.scalar("diameters_with_v_crit", found as f64);
+    s.scalar("grid_stick_count", grid_count as f64);
+    s.scalar("impacts", f64::from(impacts));
+    s.scalar("energy_created_impacts", created as f64);
+    // The critical speed at each diameter where the bisection found one, named by the diameter in µm
+    // (rounded to 1e-6 µm so that a grid diameter such as 70 µm reads `70`, not `70.00000000000001`).
+    for c in p.critical.iter().filter(|c| c.v_crit.is_finite()) {
+        let um = (c.diameter * 1e12).round() / 1e6;
+        s.scalar(&format!("v_crit_m_s_at_{}um", spatter_io::fmt_f64(um)), c.v_crit);
+    }
     Ok(s)
 }
 
@@ -518,9 +508,14 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
         (0..cases.len()).flat_map(|c| (0..base_jobs.len()).map(move |j| (c, j))).collect();
     let mut p = load_progress(cfg, ctx)?;
     ctx.control.status("snow regime map: sensitivity study");
-    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, |&(c, j)| {
-        run_job(&models[c], &base_jobs[j])
-    }) == Finished::Interrupted
+    if run_chunks(
+        &jobs,
+        &mut p,
+        |p| &mut p.records,
+        chunk_size(jobs.len()),
+        ctx,
+        |&(c, j)| run_job(&models[c], &base_jobs[j]),
+    )? == Finished::Interrupted
     {
         return interrupted(&p, ctx, jobs.len());
     }
@@ -534,6 +529,9 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
     s.artifacts.push(("every impact of every case".into(), ipath));
     let created = p.records.iter().filter(|r| r.result.created_energy()).count();
     energy_check(&mut s, created, p.records.len(), "energy_created = 1 in sensitivity_impacts.csv");
+    for (c, recs) in &sets {
+        impact_scalars(&mut s, &format!("case{c}_"), recs);
+    }
     let (n_d, n_v) = (cfg.grid.diameters, cfg.grid.normal_speeds);
     let mut rows = Vec::new();
     let mut chart = Chart::new(
@@ -692,7 +690,9 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
             hertz_time: setup.hertz_time,
         }
     };
-    if run_chunks(&jobs, &mut p.records, chunk_size(jobs.len()), ctx, run_one) == Finished::Interrupted {
+    if run_chunks(&jobs, &mut p, |p| &mut p.records, chunk_size(jobs.len()), ctx, run_one)?
+        == Finished::Interrupted
+    {
         return interrupted(&p, ctx, jobs.len());
     }
     let mut s = RunSummary::new(Finished::Completed);
@@ -701,6 +701,7 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     s.artifacts.push(("every rough-wall impact".into(), ipath));
     let created = p.records.iter().filter(|r| r.result.created_energy()).count();
     energy_check(&mut s, created, p.records.len(), "energy_created = 1 in rough_impacts.csv");
+    impact_scalars(&mut s, "", &p.records);
     // The bed for ParaView.
     let centres: Vec<Vec3> = bed.spheres.iter().map(|q| Vec3::from(q.centre)).collect();
     let radii: Vec<f64> = bed.spheres.iter().map(|q| q.radius).collect();
@@ -903,5 +904,10 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
         setup.dt
     ));
     energy_check(&mut s, usize::from(r.created_energy()), 1, "see the kinetic energy ratio above");
+    s.scalar("stuck", if r.outcome == super::impact::Outcome::Stick { 1.0 } else { 0.0 });
+    s.scalar("restitution", r.restitution);
+    s.scalar("energy_ratio", r.energy_ratio);
+    s.scalar("max_overlap_m", r.max_overlap);
+    s.scalar("contact_duration_s", r.contact_duration);
     Ok(s)
 }

@@ -6,9 +6,9 @@
 //! or the bed spheres as points with `radius_m` (`bed.vtu`).
 
 use super::config::TargetKind;
+use super::error::SnowError;
 use super::impact::TracePoint;
 use super::model::{ImpactModel, Surface};
-use super::runner::SnowError;
 use spatter_core::mesh::TriMesh;
 use spatter_core::Vec3;
 use spatter_io::pvd::PvdSeries;

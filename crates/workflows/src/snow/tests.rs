@@ -1,9 +1,10 @@
 //! Whole-workflow tests of the snow module (fast variants; the full cases run in `spatter validate`).
 
+use super::cases::model_of;
 use super::config::{Mode, SnowConfig, TargetKind};
 use super::impact::{Decision, Outcome, StickCriterion};
 use super::model::Surface;
-use super::runner::{model_of, run};
+use super::runner::run;
 use spatter_core::check::Checker;
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
 use spatter_dem::restitution_models::RestitutionModel;
@@ -145,7 +146,7 @@ fn ice_temperature_sets_the_particle_modulus() {
     let mut csv = Vec::new();
     for (name, c) in [("temperature", &cfg), ("explicit", &explicit)] {
         let d = RunDir::create(&root.path().join(name)).unwrap();
-        let s = run(c, &RunContext { dir: &d, control: &Unattended, resume: false }).unwrap();
+        let s = run(c, &RunContext::new(&d, &Unattended, false)).unwrap();
         assert_eq!(
             s.headline.iter().any(|l| l.contains("from ice_temperature_c = -12 °C")),
             name == "temperature"
@@ -168,14 +169,14 @@ fn interrupted_and_resumed_runs_equal_uninterrupted_ones() {
     for mode in [Mode::Grid, Mode::Bisection, Mode::Sensitivity, Mode::RoughWall] {
         let cfg = small(mode);
         let a = RunDir::create(&root.path().join(format!("{mode:?}_a"))).unwrap();
-        let s = run(&cfg, &RunContext { dir: &a, control: &Unattended, resume: false }).unwrap();
+        let s = run(&cfg, &RunContext::new(&a, &Unattended, false)).unwrap();
         assert_eq!(s.finished, Finished::Completed);
         let b = RunDir::create(&root.path().join(format!("{mode:?}_b"))).unwrap();
         let stop = StopAfterPolls::new(1);
-        let s = run(&cfg, &RunContext { dir: &b, control: &stop, resume: false }).unwrap();
+        let s = run(&cfg, &RunContext::new(&b, &stop, false)).unwrap();
         assert_eq!(s.finished, Finished::Interrupted, "{mode:?}");
         assert!(b.checkpoint_path().exists());
-        let s = run(&cfg, &RunContext { dir: &b, control: &Unattended, resume: true }).unwrap();
+        let s = run(&cfg, &RunContext::new(&b, &Unattended, true)).unwrap();
         assert_eq!(s.finished, Finished::Completed);
         assert!(!b.checkpoint_path().exists());
         let mut compared = 0;
@@ -209,13 +210,10 @@ fn resume_refuses_a_different_configuration() {
     let cfg = small(Mode::Grid);
     let d = RunDir::create(root.path()).unwrap();
     let stop = StopAfterPolls::new(0);
-    assert_eq!(
-        run(&cfg, &RunContext { dir: &d, control: &stop, resume: false }).unwrap().finished,
-        Finished::Interrupted
-    );
+    assert_eq!(run(&cfg, &RunContext::new(&d, &stop, false)).unwrap().finished, Finished::Interrupted);
     let mut other = cfg.clone();
     other.grid.normal_speeds = 9;
-    let e = run(&other, &RunContext { dir: &d, control: &Unattended, resume: true }).unwrap_err();
+    let e = run(&other, &RunContext::new(&d, &Unattended, true)).unwrap_err();
     assert!(e.to_string().contains("different configuration"), "{e}");
 }
 
@@ -454,7 +452,7 @@ fn oversized_runs_are_refused_before_any_work() {
     use super::config::MAX_IMPACTS;
     let root = tempfile::tempdir().unwrap();
     let dir = RunDir::create(root.path()).unwrap();
-    let ctx = RunContext { dir: &dir, control: &Unattended, resume: false };
+    let ctx = RunContext::new(&dir, &Unattended, false);
     let mut cfg = SnowConfig::default();
     cfg.grid.diameters = 10_000;
     cfg.grid.normal_speeds = 100_000;
@@ -882,7 +880,7 @@ fn impacts_that_create_energy_are_flagged() {
     cfg.integration.dt_s = Some(0.12 * t_h);
     let root = tempfile::tempdir().unwrap();
     let dir = RunDir::create(root.path()).unwrap();
-    let summary = run(&cfg, &RunContext { dir: &dir, control: &Unattended, resume: false }).unwrap();
+    let summary = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap();
     let text = std::fs::read_to_string(root.path().join("impacts.csv")).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();

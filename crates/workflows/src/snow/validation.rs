@@ -5,10 +5,10 @@
 //! reference computations.
 
 use super::bisection::{critical_speed, BracketStatus};
+use super::cases::{case_config, model_of};
 use super::config::{ice, SensitivityCase, SnowConfig, TargetKind};
 use super::material::{ice_youngs_modulus, thesis_time_step};
 use super::regime::{grid_jobs, run_job, stick_count};
-use super::runner::{case_config, model_of};
 use rayon::prelude::*;
 use spatter_core::material::{effective_modulus, Material};
 use spatter_core::validation::{Case, Check};
@@ -39,7 +39,8 @@ fn ice_abs_jkr(d: f64, gamma: f64) -> Jkr {
 /// F(0) = −8/9 F_c, F = 0 at a₀²/(3R*), F_min = −F_c at −0.48075 δ_c, F = −5/9 F_c at −δ_c.
 fn jkr_marked_points(_quick: bool) -> Vec<Check> {
     let c = "snow_jkr_marked_points";
-    let src = "VERIFICATION.md JKR; digest §2.4";
+    let src =
+        "Johnson, Kendall & Roberts (1971), Proc. R. Soc. A 324:301; marked points of the full JKR curve";
     let j = ice_abs_jkr(20e-6, 0.2);
     let fc = j.pull_off_force;
     vec![
@@ -82,7 +83,7 @@ fn jkr_marked_points(_quick: bool) -> Vec<Check> {
             3.3481e-7,
             ice_abs_jkr(10e-6, 0.2).a0,
             1e-4,
-            "digest §3.5 table",
+            "Lind (2017) JKR table",
         ),
         Check::relative(
             c,
@@ -90,7 +91,7 @@ fn jkr_marked_points(_quick: bool) -> Vec<Check> {
             6.1692e-9,
             ice_abs_jkr(10e-6, 0.2).critical_overlap,
             1e-4,
-            "digest §3.5 table",
+            "Lind (2017) JKR table",
         ),
         Check::relative(
             c,
@@ -98,7 +99,7 @@ fn jkr_marked_points(_quick: bool) -> Vec<Check> {
             4.7124e-5,
             ice_abs_jkr(100e-6, 0.2).pull_off_force,
             1e-4,
-            "digest §3.5 table",
+            "Lind (2017) JKR table",
         ),
     ]
 }
@@ -122,7 +123,7 @@ fn elastic_sticking_speed(quick: bool) -> Vec<Check> {
             reference,
             v,
             1e-4,
-            "VERIFICATION.md JKR: undamped sphere on a rigid-mass wall",
+            "JKR sticking speed of an undamped sphere on a rigid wall: energy of the full JKR curve, V_s = 1.367847 √(F_c δ_c / m)",
         ));
     }
     // Above V_s an undamped grain loses exactly the neck work: e = √(1 − (V_s/v)²). The break happens
@@ -139,7 +140,7 @@ fn elastic_sticking_speed(quick: bool) -> Vec<Check> {
             (1.0 - 1.0 / (k * k)).sqrt(),
             r.restitution,
             5e-3,
-            "energy balance: ½mv_out² = ½mv² − W_neck (VERIFICATION.md JKR)",
+            "energy balance: ½mv_out² = ½mv² − W_neck (JKR)",
         ));
     }
     // The load-controlled break needs less work: V_s = √(2·0.462014 F_cδ_c/m).
@@ -154,7 +155,7 @@ fn elastic_sticking_speed(quick: bool) -> Vec<Check> {
         reference,
         v,
         1e-4,
-        "digest §2.4 (U at x = 4^{-1/3})",
+        "JKR curve (U at x = 4^{-1/3})",
     ));
     out
 }
@@ -178,7 +179,7 @@ fn gamma_diameter_scaling(quick: bool) -> Vec<Check> {
                 1.0,
                 v1 / v0,
                 3e-5,
-                "VERIFICATION.md JKR scaling",
+                "JKR scaling v_crit(kΓ, k·d) = v_crit(Γ, d)",
             )
         })
         .collect()
@@ -238,7 +239,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             9.587,
             tabor_parameter(5e-6, 0.2, e_star, 0.4e-9),
             1e-4,
-            "digest §4.1 V1 (thesis 9.6)",
+            "Lind (2017) Tabor number (thesis 9.6)",
         ),
         Check::relative(
             c,
@@ -246,7 +247,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             41.308,
             tabor_parameter(50e-6, 0.2, e_star, 0.2e-9),
             1e-4,
-            "digest §4.1 V1 (thesis 41.3)",
+            "Lind (2017) Tabor number (thesis 41.3)",
         ),
         Check::relative(
             c,
@@ -254,7 +255,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             0.129,
             thesis_time_step(10e-6, &ice()) * 1e9,
             4e-3,
-            "digest §4.1 V2 (thesis 0.13)",
+            "Lind (2017) Eq. 24 time step (thesis 0.13)",
         ),
         Check::relative(
             c,
@@ -262,7 +263,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             2.294,
             thesis_time_step(100e-6, &ice()) * 1e9,
             5e-4,
-            "digest §4.1 V2 (thesis 2.3)",
+            "Lind (2017) Eq. 24 time step (thesis 2.3)",
         ),
         Check::relative(
             c,
@@ -270,7 +271,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             9.7724,
             ice_youngs_modulus(-12.0) / 1e9,
             1e-5,
-            "digest §4.1 V3 (thesis Eq. 20)",
+            "Lind (2017) Eq. 20",
         ),
         Check::relative(
             c,
@@ -278,7 +279,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             1.3243,
             power_law_prefactor(e_star),
             1e-4,
-            "digest §4.1 V4 (thesis Eq. 34: 1.324)",
+            "Lind (2017) Eq. 34 (1.324)",
         ),
         Check::relative(
             c,
@@ -286,7 +287,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             1.5607,
             pair_yield_prefactor(e_star),
             1e-4,
-            "digest §4.1 V5 (thesis 1.56)",
+            "Lind (2017) (1.56)",
         ),
         Check::relative(
             c,
@@ -294,7 +295,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             0.1296,
             power.restitution(1.0, &props),
             1e-3,
-            "digest §3.5 COR table",
+            "Lind (2017) restitution table",
         ),
         Check::relative(
             c,
@@ -302,7 +303,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
             0.4099,
             power.restitution(0.01, &props),
             1e-3,
-            "digest §3.5 COR table",
+            "Lind (2017) restitution table",
         ),
     ]
 }
@@ -316,7 +317,7 @@ fn critical_speeds(_quick: bool) -> Vec<Check> {
     rough.target = TargetKind::WallSphere;
     rough.partner_diameter_m = Some(1e-6);
     let sphere = critical_speed(&model_of(&rough), 10e-6, 0.1, 30.0, 1e-4, 6);
-    let src = "digest §4.4 (reference time-stepping model, thesis baseline, Thornton Eq. 34 damping)";
+    let src = "independent reference computation of the model (thesis baseline, Thornton Eq. 34 damping)";
     let ok = |s: BracketStatus, v: f64| if s == BracketStatus::Found { v } else { f64::NAN };
     vec![
         Check::relative(

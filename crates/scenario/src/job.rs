@@ -1,0 +1,315 @@
+//! The job driver: everything `spatter run` does around a scenario, the same for every kind.
+//!
+//! [`run`] prepares the run folder (refusing one that holds another run's files unless told to
+//! overwrite), writes the resolved input `run.toml`, points the log at `log.txt`, runs the scenario with
+//! periodic checkpoints (every [`JobOptions::checkpoint_interval_s`] of wall time) and stop requests
+//! (SIGINT, SIGTERM, through the caller's [`RunControl`]), checks that the results hold only finite
+//! numbers, and writes `summary.json`. Argument parsing, signal handlers, the thread pool and the
+//! `tracing` subscriber belong to the program (the CLI installs them once), so a study can call [`run`]
+//! for case after case in one process.
+//!
+//! Checkpoints are stamped with [`input_hash`], the hash of the resolved input: a resume with another
+//! scenario, another format version or a damaged file is refused with a sentence before the scenario
+//! starts (see [`spatter_io::checkpoint`]).
+
+use crate::kinds::{Loaded, RunError};
+use serde_json::Value;
+use spatter_core::control::{Finished, RunControl};
+use spatter_io::checkpoint::fnv1a;
+use spatter_io::run::{RunContext, RunDir, RunSummary};
+use spatter_io::summary::SummaryFile;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Default wall-clock time between periodic checkpoints \[s\] (five minutes): a killed run loses at most
+/// this much work, and writing even a large state this rarely costs well under 1 % of the run.
+pub const DEFAULT_CHECKPOINT_INTERVAL_S: f64 = 300.0;
+
+/// Files a run folder holds that mark it as a spatter run folder.
+const RUN_MARKERS: &[&str] = &["run.toml", "summary.json", "checkpoint.bin"];
+
+/// How to run a job.
+#[derive(Clone, Debug)]
+pub struct JobOptions {
+    /// The run folder.
+    pub out: PathBuf,
+    /// Continue from the checkpoint in `out`.
+    pub resume: bool,
+    /// Delete the files of an earlier run in `out` before starting.
+    pub overwrite: bool,
+    /// Wall-clock seconds between periodic checkpoints (> 0; default
+    /// [`DEFAULT_CHECKPOINT_INTERVAL_S`]).
+    pub checkpoint_interval_s: f64,
+    /// Files in `out` that belong to the caller (a study's `case.toml`): not another run's files, and
+    /// kept by `overwrite`.
+    pub keep: Vec<String>,
+}
+
+impl JobOptions {
+    /// A fresh run into `out` with the default checkpoint interval.
+    pub fn new(out: &Path) -> Self {
+        JobOptions {
+            out: out.to_owned(),
+            resume: false,
+            overwrite: false,
+            checkpoint_interval_s: DEFAULT_CHECKPOINT_INTERVAL_S,
+            keep: Vec::new(),
+        }
+    }
+}
+
+/// Why a job did not run or did not finish with trustworthy results.
+#[derive(Debug, Error)]
+pub enum JobError {
+    /// The run folder cannot be used (another run's files, not a folder, no checkpoint to resume).
+    #[error("{0}")]
+    Folder(String),
+    /// The checkpoint cannot be resumed.
+    #[error("{0}")]
+    Resume(String),
+    /// Reading or writing a file of the run folder failed.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// The scenario itself failed.
+    #[error("{0}")]
+    Run(RunError),
+    /// The run ended but its results hold NaN or infinity.
+    #[error("{0}")]
+    NonFinite(String),
+}
+
+/// Hash of a resolved input text, stamped into checkpoints.
+pub fn input_hash(resolved: &str) -> u64 {
+    // 0 means "not stamped"; keep real inputs away from it.
+    fnv1a(resolved.as_bytes()).max(1)
+}
+
+/// Runs `loaded` into `opts.out` (see the module docs) and returns its summary.
+pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Result<RunSummary, JobError> {
+    if !(opts.checkpoint_interval_s > 0.0 && opts.checkpoint_interval_s.is_finite()) {
+        return Err(JobError::Folder(format!(
+            "checkpoint interval {} s: expected a positive number of seconds",
+            opts.checkpoint_interval_s
+        )));
+    }
+    let resolved = loaded.scenario.resolved_toml().map_err(|e| JobError::Folder(e.to_string()))?;
+    let hash = input_hash(&resolved);
+    let dir = prepare_folder(opts, hash)?;
+    dir.write_text("run.toml", &resolved)?;
+    let earlier_wall_s = if opts.resume { earlier_wall_time(&dir) } else { 0.0 };
+    // The job's log; whatever log was open before (a study's own) is open again afterwards.
+    let previous_log = spatter_io::runlog::current();
+    spatter_io::runlog::open(&dir.root().join("log.txt"), opts.resume)?;
+    let result = run_in(loaded, &dir, opts, control, hash, earlier_wall_s);
+    if let Err(e) = &result {
+        tracing::error!("{e}");
+    }
+    spatter_io::runlog::close();
+    if let Some(p) = previous_log {
+        spatter_io::runlog::open(&p, true)?;
+    }
+    result
+}
+
+fn run_in(
+    loaded: &Loaded,
+    dir: &RunDir,
+    opts: &JobOptions,
+    control: &dyn RunControl,
+    hash: u64,
+    earlier_wall_s: f64,
+) -> Result<RunSummary, JobError> {
+    tracing::info!(
+        "spatter {} {} scenario {} → {}{}",
+        env!("CARGO_PKG_VERSION"),
+        loaded.scenario.kind(),
+        loaded.source.path.display(),
+        dir.root().display(),
+        if opts.resume { " (resumed)" } else { "" }
+    );
+    tracing::info!("threads: {}", rayon::current_num_threads());
+    let timed = Timed::new(control, Duration::from_secs_f64(opts.checkpoint_interval_s));
+    let ctx = RunContext { dir, control: &timed, resume: opts.resume, input_hash: hash };
+    let started = Instant::now();
+    let summary = loaded.scenario.run(&ctx).map_err(JobError::Run)?;
+    let wall = earlier_wall_s + started.elapsed().as_secs_f64();
+    for line in &summary.headline {
+        tracing::info!("{line}");
+    }
+    check_finite(dir.root(), &summary)?;
+    write_summary(dir, loaded, &summary, wall)?;
+    match summary.finished {
+        Finished::Completed => tracing::info!("completed in {wall:.3} s"),
+        Finished::Interrupted => tracing::info!("interrupted after {wall:.3} s; checkpoint written"),
+    }
+    Ok(summary)
+}
+
+/// Creates (or checks) the run folder.
+fn prepare_folder(opts: &JobOptions, hash: u64) -> Result<RunDir, JobError> {
+    let (out, resume, overwrite) = (opts.out.as_path(), opts.resume, opts.overwrite);
+    if out.exists() && !out.is_dir() {
+        return Err(JobError::Folder(format!("output {} exists and is not a folder", out.display())));
+    }
+    let checkpoint = out.join("checkpoint.bin");
+    if resume {
+        if !checkpoint.is_file() {
+            return Err(JobError::Folder(format!(
+                "--resume: {} holds no checkpoint.bin (the run finished, or never started); run without \
+                 --resume to start afresh",
+                out.display()
+            )));
+        }
+        spatter_io::checkpoint::verify(&checkpoint, hash).map_err(|e| JobError::Resume(e.to_string()))?;
+        return Ok(RunDir::create(out)?);
+    }
+    let entries: Vec<PathBuf> = match std::fs::read_dir(out) {
+        Ok(rd) => rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| !p.file_name().is_some_and(|n| opts.keep.iter().any(|k| n == k.as_str())))
+            .collect(),
+        Err(_) => Vec::new(),
+    };
+    if !entries.is_empty() {
+        let is_run = RUN_MARKERS.iter().any(|m| out.join(m).exists());
+        if !is_run {
+            return Err(JobError::Folder(format!(
+                "output folder {} holds {} files that are not from a spatter run; choose a new or empty \
+                 folder with --out",
+                out.display(),
+                entries.len()
+            )));
+        }
+        if !overwrite {
+            let what =
+                if checkpoint.is_file() { "an unfinished run (checkpoint.bin)" } else { "an earlier run" };
+            return Err(JobError::Folder(format!(
+                "output folder {} holds the files of {what}; use --resume to continue it, --overwrite to \
+                 delete its files and start afresh, or --out for another folder",
+                out.display()
+            )));
+        }
+        for p in entries {
+            let removed = if p.is_dir() { std::fs::remove_dir_all(&p) } else { std::fs::remove_file(&p) };
+            removed
+                .map_err(|e| JobError::Folder(format!("--overwrite: cannot delete {}: {e}", p.display())))?;
+        }
+    }
+    Ok(RunDir::create(out)?)
+}
+
+/// Wall time recorded by the interrupted session(s) before this one.
+fn earlier_wall_time(dir: &RunDir) -> f64 {
+    std::fs::read_to_string(dir.root().join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<Value>(&t).ok())
+        .and_then(|v| v.get("wall_time_s").and_then(Value::as_f64))
+        .unwrap_or(0.0)
+}
+
+/// `summary.json` (see [`spatter_io::summary`]): what the run ended with, for studies (skip finished
+/// cases, results tables) and reports; then `report.html` beside it.
+fn write_summary(dir: &RunDir, loaded: &Loaded, s: &RunSummary, wall_s: f64) -> Result<(), JobError> {
+    let kind = loaded.scenario.kind();
+    SummaryFile::of(s, kind, dir.root(), wall_s, rayon::current_num_threads()).write(dir.root())?;
+    let title = format!("{} — {kind}", loaded.source.path.display());
+    if let Err(e) = spatter_io::report::write_run_report(dir.root(), &title) {
+        tracing::warn!("no report.html: {e}");
+    }
+    Ok(())
+}
+
+/// The run's results hold only finite numbers: every scalar is finite, and no CSV file of the run folder
+/// holds an infinity (NaN is how a table marks a value that is undefined by design). The first offender
+/// is named with its file, line and column.
+pub fn check_finite(root: &Path, s: &RunSummary) -> Result<(), JobError> {
+    for (name, v) in &s.scalars {
+        if !v.is_finite() {
+            return Err(JobError::NonFinite(format!(
+                "the run's result `{name}` is {v}; the results are not trustworthy (see log.txt for the \
+                 first warning, and check time step and inputs)"
+            )));
+        }
+    }
+    let mut csvs = Vec::new();
+    collect_csv(root, &mut csvs);
+    csvs.sort();
+    for path in csvs {
+        let Ok(text) = std::fs::read_to_string(&path) else { continue };
+        let mut lines = text.lines().enumerate();
+        let header: Vec<&str> = lines.next().map(|(_, h)| h.split(',').collect()).unwrap_or_default();
+        for (i, line) in lines {
+            for (j, cell) in line.split(',').enumerate() {
+                let c = cell.trim().trim_matches('"').to_ascii_lowercase();
+                // NaN marks a quantity that is undefined by design (a probe without fluid, an overlap
+                // outside contact); infinity never is.
+                let bad = matches!(c.as_str(), "inf" | "-inf" | "+inf" | "infinity" | "-infinity");
+                if bad {
+                    let col =
+                        header.get(j).map(|h| format!("column `{h}`")).unwrap_or(format!("column {}", j + 1));
+                    return Err(JobError::NonFinite(format!(
+                        "{}:{}: {col} holds {cell}; the run's results are not trustworthy (see log.txt, and \
+                         check time step and inputs)",
+                        path.display(),
+                        i + 1
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn collect_csv(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(rd) = std::fs::read_dir(dir) else { return };
+    for e in rd.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            collect_csv(&p, out);
+        } else if p.extension().is_some_and(|x| x == "csv") {
+            out.push(p);
+        }
+    }
+}
+
+/// The caller's control plus a wall-clock timer that asks for a checkpoint every `interval`.
+struct Timed<'a> {
+    inner: &'a dyn RunControl,
+    interval: Duration,
+    last: Mutex<Instant>,
+}
+
+impl<'a> Timed<'a> {
+    fn new(inner: &'a dyn RunControl, interval: Duration) -> Self {
+        Timed { inner, interval, last: Mutex::new(Instant::now()) }
+    }
+}
+
+impl RunControl for Timed<'_> {
+    fn stop_requested(&self) -> bool {
+        self.inner.stop_requested()
+    }
+
+    fn progress(&self, done: u64, total: u64) {
+        self.inner.progress(done, total)
+    }
+
+    fn status(&self, message: &str) {
+        self.inner.status(message)
+    }
+
+    fn checkpoint_due(&self) -> bool {
+        if self.inner.checkpoint_due() {
+            return true;
+        }
+        let Ok(mut last) = self.last.lock() else { return false };
+        if last.elapsed() >= self.interval {
+            *last = Instant::now();
+            true
+        } else {
+            false
+        }
+    }
+}

@@ -1,0 +1,508 @@
+//! Running a scene: law selection, time loop, injection, outputs, checkpoint and resume.
+
+use super::config::{NormalKind, SceneConfig, TangentialKind};
+use super::setup;
+use serde::{Deserialize, Serialize};
+use spatter_core::check::Checker;
+use spatter_core::control::Finished;
+use spatter_core::Aabb;
+use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
+use spatter_dem::contact::{
+    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
+    RestitutionDamping,
+};
+use spatter_dem::error::DemError;
+use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
+use spatter_dem::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
+use spatter_dem::restitution_models::{RestitutionModel, SpeedDependentDamping};
+use spatter_dem::sim::{SimState, Simulation};
+use spatter_dem::timestep;
+use spatter_io::csv::CsvSeries;
+use spatter_io::pvd::PvdSeries;
+use spatter_io::run::{RunContext, RunSummary};
+
+/// Everything a resumed run needs.
+#[derive(Serialize, Deserialize)]
+struct Checkpoint<S> {
+    scene_hash: u64,
+    sim: SimState<S>,
+    /// State of each injector (particles and mass placed, pending draw, random generator).
+    injectors: Vec<InjectorState>,
+    output_index: u64,
+    csv_bytes: u64,
+    warnings: Vec<String>,
+}
+
+/// Runs a DEM scene into `ctx.dir`: `energy.csv`, `particles.pvd` + `particles/*.vtu`, and for every mesh
+/// wall `<name>_wall.pvd` + `walls/<name>_*.vtu` with per-triangle impact records. Stops cleanly (with
+/// `checkpoint.bin`) when `ctx.control` asks; with `ctx.resume` continues from the checkpoint so that the
+/// outputs equal those of an uninterrupted run bit for bit.
+pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> {
+    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
+    let c = &cfg.contact;
+    let damping = RestitutionDamping {
+        tensile_clamp: c.tensile_clamp,
+        calibration: c.damping_calibration,
+        tangential: c.tangential_damping,
+    };
+    let linear = LinearHistory { stiffness_ratio: c.linear_stiffness_ratio };
+    let hooke = Hooke {
+        stiffness: match (c.hooke_stiffness_n_m, c.hooke_characteristic_speed_m_s) {
+            (Some(k), _) => HookeStiffness::Constant(k),
+            (None, Some(v)) => HookeStiffness::CharacteristicVelocity(v),
+            (None, None) => HookeStiffness::CharacteristicVelocity(1.0),
+        },
+    };
+    let jkr = JkrLaw { break_criterion: c.jkr_break, damping: c.jkr_damping, coulomb: c.adhesive_coulomb };
+    let r = c.rolling;
+    let built = setup::build(cfg)?;
+    if built.speed_dependent_restitution() {
+        // Some pair has a speed-dependent e: the damping law keeps each contact's coefficient in its
+        // state (16 bytes more per contact), so it gets engines of its own; scenes with constant e only
+        // keep the default law. Every pair carries its model, the law's own is never used.
+        let d = SpeedDependentDamping {
+            model: RestitutionModel::Constant { restitution: cfg.pair_defaults.restitution },
+            base: damping,
+        };
+        let variant = MindlinVariant { history: c.tangential.mindlin_history().unwrap_or_default() };
+        let ac = c.adhesive_coulomb;
+        return match (c.normal, c.tangential) {
+            (NormalKind::Hertz, TangentialKind::Linear) => {
+                run_with(configured(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hertz, _) => {
+                run_with(configured(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hooke, TangentialKind::Linear) => {
+                run_with(configured(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Hooke, _) => {
+                run_with(configured(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Jkr, _) => {
+                run_with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
+            }
+            (NormalKind::Dmt, _) => run_with(
+                configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg),
+                built,
+                cfg,
+                ctx,
+            ),
+            (NormalKind::Sjkr, _) => run_with(
+                configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg),
+                built,
+                cfg,
+                ctx,
+            ),
+        };
+    }
+    // One monomorphised engine per combination.
+    match (c.normal, c.tangential) {
+        (NormalKind::Hertz, TangentialKind::Mindlin) => {
+            run_with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Hertz, TangentialKind::Linear) => {
+            run_with(configured(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Hooke, TangentialKind::Mindlin) => {
+            run_with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Hooke, TangentialKind::Linear) => {
+            run_with(configured(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
+        }
+        // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
+        (NormalKind::Hertz, k) => {
+            let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
+            run_with(configured(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Hooke, k) => {
+            let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
+            run_with(configured(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Jkr, _) => {
+            run_with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Dmt, _) => run_with(
+            configured(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            built,
+            cfg,
+            ctx,
+        ),
+        (NormalKind::Sjkr, _) => run_with(
+            configured(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
+            built,
+            cfg,
+            ctx,
+        ),
+    }
+}
+
+/// FNV-1a hash of the scene's JSON form: a checkpoint is only resumed with the scene that wrote it.
+fn scene_hash(cfg: &SceneConfig) -> u64 {
+    let text = serde_json::to_string(cfg).unwrap_or_default();
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+struct Outputs {
+    csv: CsvSeries,
+    particles: PvdSeries,
+    meshes: Vec<Option<PvdSeries>>,
+    index: u64,
+}
+
+impl Outputs {
+    fn write<L: ContactLaw>(
+        &mut self,
+        cfg: &SceneConfig,
+        sim: &Simulation<L>,
+        ctx: &RunContext,
+    ) -> Result<(), DemError> {
+        let io = |p: &std::path::Path| {
+            let p = p.to_owned();
+            move |source| DemError::Io { path: p, source }
+        };
+        let e = sim.energy();
+        self.csv.row(&energy_row(sim, &e)).map_err(io(self.csv.path()))?;
+        let t = sim.time();
+        if cfg.output.particles_vtu {
+            let rel = format!("particles/particles_{:05}.vtu", self.index);
+            let path = ctx.dir.path(&rel);
+            write_particles(sim, &path).map_err(io(&path))?;
+            self.particles.push(t, &rel).map_err(io(&ctx.dir.path("particles.pvd")))?;
+        }
+        if cfg.output.mesh_vtu {
+            for (w, series) in self.meshes.iter_mut().enumerate() {
+                if let Some(series) = series {
+                    let rel = format!("walls/{}_{:05}.vtu", sim.walls[w].name, self.index);
+                    let path = ctx.dir.path(&rel);
+                    write_mesh(sim, w, &path).map_err(io(&path))?;
+                    series.push(t, &rel).map_err(io(&path))?;
+                }
+            }
+        }
+        self.index += 1;
+        Ok(())
+    }
+}
+
+/// Applies the scene's energy-tracking choice to a composed law.
+/// The law with the scene's options that every combination shares (energy booking, Coulomb load).
+fn configured<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> Composed<N, D, T, R> {
+    law.energy = cfg.engine.track_energy;
+    law.coulomb_load = cfg.contact.coulomb_load;
+    law
+}
+
+fn run_with<L: ContactLaw>(
+    law: L,
+    built: setup::Built,
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+) -> Result<RunSummary, DemError> {
+    let e = &cfg.engine;
+    let settings = spatter_dem::sim::Settings {
+        integrator: e.integrator,
+        skin: e.skin_m,
+        verlet_list: e.verlet_list,
+        max_overlap_fraction: e.max_overlap_fraction,
+        domain: match (e.domain_min_m, e.domain_max_m) {
+            (Some(a), Some(b)) => Some(Aabb::new(a, b)),
+            _ => None,
+        },
+    };
+    let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
+    sim.energy_method =
+        if e.track_energy { e.energy_method } else { spatter_dem::sim::EnergyMethod::PerContact };
+    sim.gravity = cfg.gravity_m_s2;
+    for w in built.walls {
+        sim.add_wall(w);
+    }
+    let mut injectors = setup::injectors(cfg)?;
+    let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
+    let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
+    let inject_every: Vec<u64> =
+        cfg.inject.iter().map(|j| ((j.interval_s / cfg.dt_s).round() as u64).max(1)).collect();
+    let hash = scene_hash(cfg);
+    let dir = ctx.dir;
+    let csv_path = dir.path("energy.csv");
+    let pvd_path = dir.path("particles.pvd");
+    let mesh_pvd = |name: &str| dir.path(&format!("{name}_wall.pvd"));
+    let io = |p: &std::path::Path| {
+        let p = p.to_owned();
+        move |source| DemError::Io { path: p, source }
+    };
+    let warnings: Vec<String>;
+    let mut out;
+    if ctx.resume {
+        let ck: Checkpoint<L::State> = ctx.load_checkpoint()?;
+        if ck.scene_hash != hash {
+            return Err(DemError::Resume(format!(
+                "{} was written by a different scene; run without resume to start afresh",
+                dir.checkpoint_path().display()
+            )));
+        }
+        sim.restore(ck.sim).map_err(DemError::Resume)?;
+        if ck.injectors.len() != injectors.len() {
+            return Err(DemError::Resume("the number of injectors changed".into()));
+        }
+        for (slot, state) in injectors.iter_mut().zip(ck.injectors) {
+            slot.0.state = state;
+        }
+        let t = sim.time();
+        let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
+        particles.truncate_after(t).map_err(io(&pvd_path))?;
+        let mut meshes = Vec::new();
+        for w in 0..sim.walls.len() {
+            meshes.push(if sim.is_mesh_wall(w) {
+                let p = mesh_pvd(&sim.walls[w].name);
+                let mut s = PvdSeries::load_or_new(&p).map_err(io(&p))?;
+                s.truncate_after(t).map_err(io(&p))?;
+                Some(s)
+            } else {
+                None
+            });
+        }
+        out = Outputs {
+            csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
+            particles,
+            meshes,
+            index: ck.output_index,
+        };
+        warnings = ck.warnings;
+        tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
+    } else {
+        for p in setup::initial_particles(cfg, &sim.walls)? {
+            sim.add_particle(p);
+        }
+        warnings = time_step_warnings(cfg, &sim);
+        for w in &warnings {
+            tracing::warn!("{w}");
+        }
+        let meshes = (0..sim.walls.len())
+            .map(|w| sim.is_mesh_wall(w).then(|| PvdSeries::new(&mesh_pvd(&sim.walls[w].name))))
+            .collect();
+        out = Outputs {
+            csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
+            particles: PvdSeries::new(&pvd_path),
+            meshes,
+            index: 0,
+        };
+        out.write(cfg, &sim, ctx)?;
+    }
+
+    while sim.step_count() < total_steps {
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
+            out.csv.flush().map_err(io(&csv_path))?;
+            let ck = Checkpoint {
+                scene_hash: hash,
+                sim: sim.state(),
+                injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
+                output_index: out.index,
+                csv_bytes: out.csv.bytes_written(),
+                warnings: warnings.clone(),
+            };
+            ctx.save_checkpoint(&ck)?;
+        }
+        if stop {
+            let mut s = RunSummary::new(Finished::Interrupted);
+            s.headline.push(format!(
+                "stopped at step {} of {total_steps} (t = {:.6} s); checkpoint written, resume to continue",
+                sim.step_count(),
+                sim.time()
+            ));
+            return Ok(s);
+        }
+        let step = sim.step_count();
+        for (k, (inj, region)) in injectors.iter_mut().enumerate() {
+            if step % inject_every[k] == 0 {
+                inject(&mut sim, inj, region, k);
+            }
+        }
+        if (step + 1) % out_every == 0 || step + 1 == total_steps {
+            sim.request_energy();
+        }
+        sim.step()?;
+        if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {
+            out.write(cfg, &sim, ctx)?;
+        }
+        if sim.step_count() % 200 == 0 {
+            ctx.control.progress(sim.step_count(), total_steps);
+        }
+    }
+    out.csv.flush().map_err(io(&csv_path))?;
+    let _ = std::fs::remove_file(dir.checkpoint_path());
+    Ok(summary(cfg, &sim, &injectors, &warnings, ctx))
+}
+
+/// Places the particles injector `k` owes at the current time, clear of the particles present and of the
+/// walls where they are now.
+fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
+    let t = sim.time();
+    if t < inj.start || (inj.due(t) == 0 && inj.state.pending.is_some()) {
+        return;
+    }
+    let reach = region.bounds().inflated(sim.particles.radius.iter().copied().fold(0.0, f64::max));
+    let p = &sim.particles;
+    let existing: Vec<_> =
+        (0..p.len()).filter(|&i| reach.contains(p.pos[i])).map(|i| (p.pos[i], p.radius[i])).collect();
+    let postponed = inj.state.postponed;
+    let placed = inj.place(region, t, &existing, &WallClearance::new(&sim.walls, t));
+    if postponed == 0 && inj.state.postponed > 0 {
+        tracing::warn!(
+            "inject[{k}]: at t = {t:.6} s the region had no room for the next particle (diameter {:e} m) \
+             in {} random positions; it waits for the next placement (the run summary gives the total)",
+            inj.state.pending.unwrap_or(0.0),
+            inj.attempts
+        );
+    }
+    for (x, r) in placed {
+        let mut np = spatter_dem::particles::NewParticle::at(x, r, inj.material);
+        np.vel = inj.velocity;
+        sim.add_particle(np);
+    }
+}
+
+/// Time-step warnings for the particles present and to be injected.
+fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<String> {
+    let mut sizes: Vec<(usize, f64)> = Vec::new();
+    let p = &sim.particles;
+    for i in 0..p.len() {
+        sizes.push((p.material[i] as usize, p.radius[i]));
+    }
+    for j in &cfg.inject {
+        if let Some(m) = cfg.materials.keys().position(|k| *k == j.material) {
+            sizes.push((m, 0.5 * setup::min_diameter(&j.size)));
+        }
+    }
+    let mats = sim.materials();
+    let mut t_r = f64::INFINITY;
+    let mut t_h = f64::INFINITY;
+    // Highest impact speed: the configured one, or the fall speed across the scene plus initial speeds.
+    let v = cfg.engine.impact_speed_m_s.unwrap_or_else(|| {
+        // Height scale: particles, injection regions and mesh walls.
+        let mut b = Aabb::EMPTY;
+        for x in &p.pos {
+            b = b.grown_to(*x);
+        }
+        for j in &cfg.inject {
+            if let Ok(r) = setup::region(cfg, &j.region) {
+                b = b.union(r.bounds());
+            }
+        }
+        for w in &sim.walls {
+            if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
+                b = b.union(m.mesh.bounds());
+            }
+        }
+        let h = if b.is_empty() { 0.0 } else { b.extent().length() };
+        let v0 = p.vel.iter().map(|v| v.length()).fold(0.0, f64::max);
+        let vi = cfg.inject.iter().map(|j| j.velocity_m_s.length()).fold(0.0, f64::max);
+        (2.0 * cfg.gravity_m_s2.length() * h).sqrt() + v0.max(vi) + 1e-3
+    });
+    let mut seen = std::collections::BTreeSet::new();
+    for (m, r) in sizes {
+        if !seen.insert((m, r.to_bits())) {
+            continue;
+        }
+        t_r = t_r.min(timestep::rayleigh(&mats[m], r));
+        t_h = t_h.min(timestep::hertz(&mats[m], &mats[m], r, 2.0 * v, true));
+        for w in &sim.walls {
+            t_h = t_h.min(timestep::hertz(&mats[m], &mats[w.material as usize], r, v, false));
+        }
+    }
+    let mut out = Vec::new();
+    if let Some(w) = timestep::check_dt(cfg.dt_s, t_r, t_h) {
+        out.push(w);
+    }
+    out
+}
+
+fn summary<L: ContactLaw>(
+    cfg: &SceneConfig,
+    sim: &Simulation<L>,
+    injectors: &[(Injector, Region)],
+    warnings: &[String],
+    ctx: &RunContext,
+) -> RunSummary {
+    let mut s = RunSummary::new(Finished::Completed);
+    let e = sim.energy();
+    s.headline.push(format!(
+        "{} particles, {} steps of {:e} s to t = {:.6} s, {} list rebuilds, {} removed",
+        sim.particles.len(),
+        sim.step_count(),
+        cfg.dt_s,
+        sim.time(),
+        sim.rebuild_count(),
+        sim.removed_count()
+    ));
+    s.headline.push(format!(
+        "energy [J]: kinetic {:.4e}, rotational {:.4e}, elastic {:.4e}, dissipated {:.4e}, budget total {:.6e}",
+        e.kinetic,
+        e.rotational,
+        e.elastic,
+        e.dissipated,
+        e.total()
+    ));
+    for (name, value) in [
+        ("particles", sim.particles.len() as f64),
+        ("removed", sim.removed_count() as f64),
+        ("t_end_s", sim.time()),
+        ("kinetic_J", e.kinetic),
+        ("rotational_J", e.rotational),
+        ("elastic_J", e.elastic),
+        ("dissipated_J", e.dissipated),
+        ("budget_total_J", e.total()),
+    ] {
+        s.scalar(name, value);
+    }
+    s.headline.push(format!(
+        "contacts: {} particle-particle, {} particle-wall; time step {:.1} % of the Rayleigh time; {:.0} bytes \
+         of state per particle",
+        e.pair_contacts,
+        e.wall_contacts,
+        100.0 * cfg.dt_s / sim.rayleigh_time(),
+        sim.bytes_per_particle()
+    ));
+    for (k, (inj, _)) in injectors.iter().enumerate() {
+        let t = sim.time();
+        let target = match inj.rate {
+            InjectionRate::ParticlesPerSecond(_) => format!("{:.0} particles", inj.target(t)),
+            InjectionRate::KgPerSecond(_) => format!("{:.6e} kg", inj.target(t)),
+        };
+        s.headline.push(format!(
+            "inject[{k}]: {} particles, {:.6e} kg placed (target {target})",
+            inj.state.inserted, inj.state.mass
+        ));
+        if inj.state.postponed > 0 {
+            s.headline.push(format!(
+                "warning: inject[{k}]: the region was full at {} placement times; particles waited for room",
+                inj.state.postponed
+            ));
+        }
+    }
+    for w in warnings {
+        s.headline.push(format!("warning: {w}"));
+    }
+    s.artifacts.push(("energy budget".into(), ctx.dir.path("energy.csv")));
+    if cfg.output.particles_vtu {
+        s.artifacts.push(("particles (ParaView)".into(), ctx.dir.path("particles.pvd")));
+    }
+    if cfg.output.mesh_vtu {
+        for w in 0..sim.walls.len() {
+            if sim.is_mesh_wall(w) {
+                let name = &sim.walls[w].name;
+                s.artifacts.push((
+                    format!("wall {name} impacts (ParaView)"),
+                    ctx.dir.path(&format!("{name}_wall.pvd")),
+                ));
+            }
+        }
+    }
+    s
+}

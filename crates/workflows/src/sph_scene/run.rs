@@ -1,0 +1,502 @@
+//! Running an `sph` scenario: time loop, outputs, checkpoint and resume.
+
+use super::build::{build, BuildInfo};
+use super::config::SphConfig;
+use serde::{Deserialize, Serialize};
+use spatter_core::control::Finished;
+use spatter_core::Vec3;
+use spatter_io::csv::{write_table, CsvSeries};
+use spatter_io::pvd::PvdSeries;
+use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::vtu::Vtu;
+use spatter_sph::error::SphError;
+use spatter_sph::sim::Simulation;
+use spatter_sph::wetting::{default_view, particle_map, wet_area, wetting_map};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Everything a resumed run needs besides the configuration.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct SceneState {
+    sim: Simulation,
+    info: BuildInfo,
+    next_vtu: f64,
+    vtu_count: u32,
+    next_sample: f64,
+    series_bytes: u64,
+    /// ∫ volume per height bin dt over the averaging window \[m⁴ or m³ in 2D\], and the time covered.
+    height_volume_time: Vec<f64>,
+    height_time: f64,
+    flux_started: bool,
+    flux_up: Vec<f64>,
+    flux_down: Vec<f64>,
+    /// Wall-clock seconds of earlier sessions.
+    wall_seconds: f64,
+}
+
+/// Column names of `series.csv`.
+fn series_columns(cfg: &SphConfig, sim: &Simulation) -> Vec<String> {
+    let mut c: Vec<String> = [
+        "t_s",
+        "dt_s",
+        "step",
+        "particles",
+        "removed_outside_domain",
+        "removed_density_window",
+        "kinetic_energy_J",
+        "max_speed_m_s",
+        "max_density_ratio",
+        "min_density_ratio",
+        "guard_stops",
+        "dt_acoustic_s",
+        "dt_force_s",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for p in &sim.boundary.parts {
+        for q in ["Fx_N", "Fy_N", "Fz_N", "Mx_Nm", "My_Nm", "Mz_Nm", "wet_area_m2"] {
+            c.push(format!("{}_{q}", p.name));
+        }
+    }
+    for p in &cfg.sensors.probes {
+        for q in ["p_Pa", "vx_m_s", "vy_m_s", "vz_m_s"] {
+            c.push(format!("{}_{q}", p.name));
+        }
+    }
+    for p in &cfg.sensors.wall_probes {
+        c.push(format!("{}_p_Pa", p.name));
+    }
+    c
+}
+
+fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<f64> {
+    let l = sim.last;
+    let mut r = vec![
+        sim.time,
+        sim.dt,
+        sim.steps as f64,
+        sim.fluid.len() as f64,
+        sim.removed.outside_domain as f64,
+        sim.removed.density_window as f64,
+        sim.kinetic_energy(),
+        l.max_speed,
+        l.max_density_ratio,
+        l.min_density_ratio,
+        l.guard_hits as f64,
+        l.dt_acoustic,
+        l.dt_force,
+    ];
+    let loads = sim.part_loads();
+    for (k, ld) in loads.iter().enumerate() {
+        let wa = wet_area(sim, k, sim.time);
+        r.extend([ld.force.x, ld.force.y, ld.force.z, ld.torque.x, ld.torque.y, ld.torque.z, wa.wet_now]);
+    }
+    for p in &cfg.sensors.probes {
+        match sim.probe(p.position_m) {
+            Some((pr, v)) => r.extend([pr, v.x, v.y, v.z]),
+            None => r.extend([f64::NAN; 4]),
+        }
+    }
+    for p in &cfg.sensors.wall_probes {
+        r.push(sim.wall_pressure(p.position_m, p.radius_m).unwrap_or(f64::NAN));
+    }
+    r
+}
+
+fn write_particles(dir: &Path, rel: &str, cfg: &SphConfig, sim: &Simulation) -> std::io::Result<()> {
+    let base = cfg.sensors.height.as_ref().map(|h| h.base_z_m).unwrap_or(0.0);
+    let f = &sim.fluid;
+    let height: Vec<f64> = f.pos.iter().map(|p| p.z - base).collect();
+    let ids: Vec<i64> = f.id.iter().map(|&i| i as i64).collect();
+    Vtu::point_cloud(&f.pos)
+        .point_vector("velocity_m_s", &f.vel)
+        .point_scalar("pressure_Pa", &sim.pressures())
+        .point_scalar("density_kg_m3", &f.rho)
+        .point_scalar("height_m", &height)
+        .point_int("id", &ids)
+        .write(&dir.join(rel))
+}
+
+fn write_walls(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+    let b = &sim.boundary;
+    let part: Vec<i64> = b.part.iter().map(|&p| p as i64).collect();
+    let wet: Vec<i64> = b.wet.iter().map(|&w| w as i64).collect();
+    let n = b.len();
+    let pos: Vec<Vec3> = (0..n).map(|i| b.position(i)).collect();
+    let vel: Vec<Vec3> = (0..n).map(|i| b.velocity(i)).collect();
+    let nrm: Vec<Vec3> = (0..n).map(|i| b.normal(i)).collect();
+    Vtu::point_cloud(&pos)
+        .point_vector("velocity_m_s", &vel)
+        .point_vector("normal", &nrm)
+        .point_scalar("area_m2", &b.area)
+        .point_scalar("volume_m3", &b.volume)
+        .point_scalar("wet_time_s", &b.wet_time)
+        .point_int("wet", &wet)
+        .point_int("part", &part)
+        .write(path)
+}
+
+fn io_at(path: &Path) -> impl Fn(std::io::Error) -> SphError + '_ {
+    move |e| SphError::Io(std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
+}
+
+/// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). Relative paths in the
+/// configuration are resolved against the current directory.
+pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
+    run_in(cfg, ctx, Path::new("."))
+}
+
+/// Like [`run`], resolving relative paths against `base`.
+pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSummary, SphError> {
+    let dir = ctx.dir;
+    let root = dir.root().to_owned();
+    let ckpt = dir.checkpoint_path();
+    let series_path = dir.path("series.csv");
+    let pvd_path = dir.path("particles.pvd");
+    let session = Instant::now();
+    let (mut st, mut series, mut pvd) = if ctx.resume && ckpt.exists() {
+        let mut st: SceneState = ctx.load_checkpoint()?;
+        st.sim.refresh();
+        let cols = series_columns(cfg, &st.sim);
+        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+        let series = CsvSeries::resume(&series_path, &cols, st.series_bytes).map_err(io_at(&series_path))?;
+        let mut pvd = PvdSeries::load_or_new(&pvd_path).map_err(io_at(&pvd_path))?;
+        pvd.truncate_after(st.sim.time).map_err(io_at(&pvd_path))?;
+        tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
+        (st, series, pvd)
+    } else {
+        let (sim, info) = build(cfg, base)?;
+        tracing::info!(
+            "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s)",
+            cfg.title,
+            info.fluid_particles,
+            info.wall_particles,
+            sim.params.spacing,
+            sim.params.h(),
+            info.u_max,
+            info.sound_speed,
+            sim.dt,
+            rayon::current_num_threads()
+        );
+        for w in &info.warnings {
+            tracing::warn!("{w}");
+        }
+        let cols = series_columns(cfg, &sim);
+        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+        let series = CsvSeries::create(&series_path, &cols).map_err(io_at(&series_path))?;
+        let pvd = PvdSeries::new(&pvd_path);
+        let nb = cfg.sensors.height.as_ref().map(|h| h.bins).unwrap_or(0);
+        let st = SceneState {
+            sim,
+            info,
+            next_vtu: 0.0,
+            vtu_count: 0,
+            next_sample: 0.0,
+            series_bytes: 0,
+            height_volume_time: vec![0.0; nb],
+            height_time: 0.0,
+            flux_started: false,
+            flux_up: vec![0.0; nb + 1],
+            flux_down: vec![0.0; nb + 1],
+            wall_seconds: 0.0,
+        };
+        if cfg.output.wall_particles {
+            let p = dir.path("walls.vtu");
+            write_walls(&p, &st.sim).map_err(io_at(&p))?;
+        }
+        (st, series, pvd)
+    };
+    let end = cfg.output.end_time_s;
+    let vtu_dt = cfg.output.vtu_interval();
+    let sample_dt = cfg.output.sample_interval();
+    let total_steps_estimate = (end / st.sim.dt.max(1e-12)) as u64;
+    loop {
+        // Outputs due at the current time.
+        if st.sim.time >= st.next_sample - 1e-12 * end {
+            let row = series_row(cfg, &mut st.sim);
+            series.row(&row).map_err(io_at(&series_path))?;
+            while st.next_sample <= st.sim.time + 1e-12 * end {
+                st.next_sample += sample_dt;
+            }
+        }
+        if st.sim.time >= st.next_vtu - 1e-12 * end {
+            let rel = format!("particles/particles_{:05}.vtu", st.vtu_count);
+            dir.path(&rel);
+            write_particles(&root, &rel, cfg, &st.sim).map_err(io_at(&root.join(&rel)))?;
+            pvd.push(st.sim.time, &rel).map_err(io_at(&pvd_path))?;
+            if cfg.output.wall_particles {
+                let wrel = format!("walls/walls_{:05}.vtu", st.vtu_count);
+                let p = dir.path(&wrel);
+                write_walls(&p, &st.sim).map_err(io_at(&p))?;
+            }
+            st.vtu_count += 1;
+            let l = st.sim.last;
+            tracing::info!(
+                "t = {:.6} s, step {}, dt = {:.4e} s (acoustic {:.3e}, force {:.3e}, viscous {:.3e}), {} particles, removed {} (domain) + {} (density), max speed {:.4} m/s, density {:.4}–{:.4} ρ0, guard stops {}",
+                st.sim.time,
+                st.sim.steps,
+                st.sim.dt,
+                l.dt_acoustic,
+                l.dt_force,
+                l.dt_viscous,
+                st.sim.fluid.len(),
+                st.sim.removed.outside_domain,
+                st.sim.removed.density_window,
+                l.max_speed,
+                l.min_density_ratio,
+                l.max_density_ratio,
+                l.guard_hits
+            );
+            if l.max_speed > 0.1 * st.sim.params.sound_speed {
+                tracing::warn!(
+                    "max speed {:.4} m/s exceeds c0/10 = {:.4} m/s; density errors may exceed 1 % — raise fluid.max_velocity_m_s",
+                    l.max_speed,
+                    0.1 * st.sim.params.sound_speed
+                );
+            }
+            while st.next_vtu <= st.sim.time + 1e-12 * end {
+                st.next_vtu += vtu_dt;
+            }
+        }
+        if st.sim.time >= end - 1e-12 * end {
+            break;
+        }
+        let stop = ctx.control.stop_requested();
+        if stop || ctx.checkpoint_due() {
+            series.flush().map_err(io_at(&series_path))?;
+            st.series_bytes = series.bytes_written();
+            // The checkpoint holds the wall time up to now; this session's count goes on from here.
+            let earlier = st.wall_seconds;
+            st.wall_seconds += session.elapsed().as_secs_f64();
+            ctx.save_checkpoint(&st)?;
+            if stop {
+                tracing::info!(
+                    "stopped at t = {:.6} s, step {}; checkpoint written",
+                    st.sim.time,
+                    st.sim.steps
+                );
+                let mut s = RunSummary::new(Finished::Interrupted);
+                s.headline
+                    .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
+                s.artifacts.push(("checkpoint".into(), ckpt));
+                return Ok(s);
+            }
+            st.wall_seconds = earlier;
+        }
+        st.sim.step()?;
+        accumulate_height(cfg, &mut st);
+        ctx.control.progress(st.sim.steps, total_steps_estimate.max(st.sim.steps));
+    }
+    series.flush().map_err(io_at(&series_path))?;
+    let wall = st.wall_seconds + session.elapsed().as_secs_f64();
+    finish(cfg, ctx, st, wall)
+}
+
+/// Height bins and plane fluxes over the averaging window.
+fn accumulate_height(cfg: &SphConfig, st: &mut SceneState) {
+    let Some(h) = &cfg.sensors.height else { return };
+    let sim = &mut st.sim;
+    let [t0, t1] = h.window_s;
+    let t = sim.time;
+    if !st.flux_started && t >= t0 {
+        sim.reset_flux();
+        st.flux_started = true;
+    }
+    if t > t0 && t - sim.last_dt() < t1 {
+        // Portion of the last step inside the window.
+        let lo = (t - sim.last_dt()).max(t0);
+        let hi = t.min(t1);
+        let w = (hi - lo).max(0.0);
+        let m = sim.params.mass();
+        for (x, rho) in sim.fluid.pos.iter().zip(&sim.fluid.rho) {
+            let k = ((x.z - h.base_z_m) / h.bin_m).floor();
+            if k >= 0.0 && (k as usize) < h.bins {
+                st.height_volume_time[k as usize] += m / rho * w;
+            }
+        }
+        st.height_time += w;
+        if t >= t1 {
+            st.flux_up.clone_from(&sim.flux_up);
+            st.flux_down.clone_from(&sim.flux_down);
+        }
+    }
+}
+
+fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Result<RunSummary, SphError> {
+    let dir = ctx.dir;
+    let mut sim = st.sim;
+    let mut summary = RunSummary::new(Finished::Completed);
+    let elapsed = sim.time;
+    // Wetting maps and wet areas.
+    let mut rows = Vec::new();
+    for k in 0..sim.boundary.parts.len() {
+        let name = sim.boundary.parts[k].name.clone();
+        let wa = wet_area(&sim, k, elapsed);
+        rows.push(vec![
+            name.clone(),
+            spatter_io::fmt_f64(wa.area),
+            spatter_io::fmt_f64(wa.wet_now),
+            spatter_io::fmt_f64(wa.wet_mean),
+            spatter_io::fmt_f64(if wa.area > 0.0 { wa.wet_mean / wa.area } else { 0.0 }),
+        ]);
+        let wcfg = cfg.walls.iter().find(|w| w.name == name);
+        if !wcfg.map(|w| w.wetting_map).unwrap_or(true) {
+            continue;
+        }
+        let map = wetting_map(&sim, k, elapsed);
+        if map.mesh.triangles.is_empty() {
+            continue;
+        }
+        let vtu = dir.path(&format!("wetting/{name}.vtu"));
+        Vtu::triangles(&map.mesh.vertices, &map.mesh.triangles)
+            .cell_scalar("wet_now", &map.wet_now)
+            .cell_scalar("wet_time_fraction", &map.wet_time_fraction)
+            .write(&vtu)
+            .map_err(io_at(&vtu))?;
+        let (dv, du) = default_view(&sim, k);
+        let view = wcfg.and_then(|w| w.view_dir).unwrap_or(dv);
+        let up = wcfg.and_then(|w| w.up).unwrap_or(du);
+        let png = dir.path(&format!("wetting/{name}.png"));
+        let (squares, fraction) = particle_map(&sim, k, elapsed);
+        spatter_io::plot::mesh_map_png(
+            &png,
+            &squares,
+            &fraction,
+            view,
+            up,
+            &format!("{name}: fraction of time wet (0–{elapsed:.3} s)"),
+            "time wet / elapsed",
+        )
+        .map_err(io_at(&png))?;
+        summary.artifacts.push((format!("wetting map {name}"), png));
+    }
+    let wet_csv = dir.path("wetting.csv");
+    write_table(
+        &wet_csv,
+        &["wall", "area_m2", "wet_area_now_m2", "mean_wet_area_m2", "mean_wet_fraction"],
+        &rows,
+    )
+    .map_err(io_at(&wet_csv))?;
+    summary.artifacts.push(("wet areas".into(), wet_csv));
+    // Splash heights.
+    let mut splash_scalars: Vec<(String, f64)> = Vec::new();
+    if let Some(h) = &cfg.sensors.height {
+        let x = h.reference_depth_m.unwrap_or(h.bin_m);
+        // The plane counters are frozen when the window closes. A run that ends inside the window (before
+        // `window_s[1]`) reports what they counted up to its end, over the time it covered — as the volumes
+        // are; until 2026-11-24 it reported zero flux.
+        let [t0, t1] = h.window_s;
+        let closed = sim.time >= t1;
+        let (flux_up, flux_down, span) = if closed || !st.flux_started {
+            (&st.flux_up, &st.flux_down, t1 - t0)
+        } else {
+            tracing::info!(
+                "splash heights: the run ended at t = {:.6} s inside the window [{t0}, {t1}] s; volumes and fluxes are averaged over [{t0}, {:.6}] s",
+                sim.time, sim.time
+            );
+            (&sim.flux_up, &sim.flux_down, st.height_time)
+        };
+        let mut rows = Vec::new();
+        let mut vol_pts = Vec::new();
+        let mut flux_pts = Vec::new();
+        for k in 0..h.bins {
+            let lo = k as f64 * h.bin_m;
+            let vol = if st.height_time > 0.0 { st.height_volume_time[k] / st.height_time } else { 0.0 };
+            // Flux through the bin's lower edge.
+            let rate = |v: &Vec<f64>| if span > 0.0 { v.get(k).copied().unwrap_or(0.0) / span } else { 0.0 };
+            let (up, down) = (rate(flux_up), rate(flux_down));
+            rows.push(vec![
+                spatter_io::fmt_f64(lo),
+                spatter_io::fmt_f64(lo + h.bin_m),
+                spatter_io::fmt_f64((lo + 0.5 * h.bin_m) / x),
+                spatter_io::fmt_f64(vol),
+                spatter_io::fmt_f64(up),
+                spatter_io::fmt_f64(up - down),
+            ]);
+            vol_pts.push(((lo + 0.5 * h.bin_m) / x, vol));
+            flux_pts.push((lo / x, up));
+        }
+        let p = dir.path("splash_height.csv");
+        write_table(
+            &p,
+            &[
+                "bin_low_m",
+                "bin_high_m",
+                "height_over_depth",
+                "mean_volume_m3",
+                "upward_flux_lower_edge_m3_s",
+                "net_flux_lower_edge_m3_s",
+            ],
+            &rows,
+        )
+        .map_err(io_at(&p))?;
+        summary.artifacts.push(("splash heights".into(), p));
+        // Volume-weighted mean height of the resident water and the highest bin holding any.
+        let total: f64 = vol_pts.iter().map(|(_, v)| v).sum();
+        if total > 0.0 {
+            let mean = vol_pts.iter().map(|(h, v)| h * v).sum::<f64>() / total;
+            let top = vol_pts.iter().filter(|(_, v)| *v > 0.0).map(|(h, _)| *h).fold(0.0, f64::max);
+            splash_scalars.push(("splash_mean_height_over_depth".into(), mean));
+            splash_scalars.push(("splash_top_bin_height_over_depth".into(), top));
+        }
+        let png = dir.path("splash_height.png");
+        spatter_io::plot::Chart::new("Splash height distribution", "height / depth", "mean volume [m³]")
+            .line("resident volume per bin", &vol_pts)
+            .save_png(&png)
+            .map_err(io_at(&png))?;
+        summary.artifacts.push(("splash height plot".into(), png));
+    }
+    // Cost.
+    let threads = rayon::current_num_threads();
+    let cost = format!(
+        "run cost: {} fluid + {} wall particles, {} steps, {:.1} s wall time, {} thread(s), {:.4} core-hours, {:.3e} particle-steps/s",
+        sim.fluid.len(),
+        sim.boundary.len(),
+        sim.steps,
+        wall,
+        threads,
+        wall * threads as f64 / 3600.0,
+        st.info.fluid_particles as f64 * sim.steps as f64 / wall.max(1e-9)
+    );
+    let loads = sim.part_loads();
+    summary.headline.push(format!(
+        "t = {:.4} s in {} steps; {} particles left, {} removed (outside the domain) and {} (density window)",
+        sim.time,
+        sim.steps,
+        sim.fluid.len(),
+        sim.removed.outside_domain,
+        sim.removed.density_window
+    ));
+    for (k, p) in sim.boundary.parts.iter().enumerate() {
+        let wa = wet_area(&sim, k, elapsed);
+        let f: Vec3 = loads[k].force;
+        summary.headline.push(format!(
+            "{}: wet now {:.4e} m², mean wet {:.4e} m² of {:.4e} m²; fluid force [{:.4e}, {:.4e}, {:.4e}] N",
+            p.name, wa.wet_now, wa.wet_mean, wa.area, f.x, f.y, f.z
+        ));
+        summary.scalar(&format!("{}_wet_area_now_m2", p.name), wa.wet_now);
+        summary.scalar(&format!("{}_mean_wet_area_m2", p.name), wa.wet_mean);
+        let fraction = if wa.area > 0.0 { wa.wet_mean / wa.area } else { 0.0 };
+        summary.scalar(&format!("{}_mean_wet_fraction", p.name), fraction);
+        summary.scalar(&format!("{}_Fz_N", p.name), f.z);
+    }
+    for (name, value) in [
+        ("t_end_s", sim.time),
+        ("steps", sim.steps as f64),
+        ("fluid_particles", sim.fluid.len() as f64),
+        ("removed_outside_domain", sim.removed.outside_domain as f64),
+        ("removed_density_window", sim.removed.density_window as f64),
+    ] {
+        summary.scalar(name, value);
+    }
+    summary.scalars.append(&mut splash_scalars);
+    summary.headline.push(cost);
+    summary.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
+    summary.artifacts.push(("time series".into(), dir.path("series.csv")));
+    let ckpt: PathBuf = dir.checkpoint_path();
+    if ckpt.exists() {
+        std::fs::remove_file(&ckpt).map_err(io_at(&ckpt))?;
+    }
+    Ok(summary)
+}
