@@ -698,9 +698,9 @@ mod tests {
                 let path = dir.path().join("checkpoint.bin");
                 for s in 0..40 {
                     if Some(s) == split {
-                        spatter_io::checkpoint::save(&path, &f.state).unwrap();
+                        spatter_io::checkpoint::save(&path, 7, &f.state).unwrap();
                         f = square_cavity(24, 400.0, 0.5, Numerics::default()).unwrap();
-                        f.restore(spatter_io::checkpoint::load(&path).unwrap()).unwrap();
+                        f.restore(spatter_io::checkpoint::load(&path, 7).unwrap()).unwrap();
                     }
                     // A variable step exercises the AB2 step-ratio history in the checkpoint.
                     f.step(0.01 + 0.0005 * (s % 3) as f64).unwrap();
