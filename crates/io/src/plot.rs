@@ -374,6 +374,23 @@ pub fn mesh_map_png(
     title: &str,
     colorbar_label: &str,
 ) -> io::Result<()> {
+    mesh_map_png_range(path, mesh, values, None, view_dir, up, title, colorbar_label)
+}
+
+/// Like [`mesh_map_png`], on the colour scale `range` = `[low, high]` when given (values beyond it take
+/// the end colours, so maps of several runs compare on one scale), else from min(0, smallest value) to
+/// the largest value.
+#[allow(clippy::too_many_arguments)]
+pub fn mesh_map_png_range(
+    path: &Path,
+    mesh: &TriMesh,
+    values: &[f64],
+    range: Option<[f64; 2]>,
+    view_dir: Vec3,
+    up: Vec3,
+    title: &str,
+    colorbar_label: &str,
+) -> io::Result<()> {
     if values.len() != mesh.triangles.len() {
         return Err(err(path, format!("{} values for {} triangles", values.len(), mesh.triangles.len())));
     }
@@ -400,7 +417,11 @@ pub fn mesh_map_png(
     let finite = values.iter().copied().filter(|v| v.is_finite());
     let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
     let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
-    let (vmin, vmax) = if vmax.is_finite() && vmax > vmin { (vmin, vmax) } else { (0.0, 1.0) };
+    let (vmin, vmax) = match range {
+        Some([lo, hi]) if hi > lo => (lo, hi),
+        _ if vmax.is_finite() && vmax > vmin => (vmin, vmax),
+        _ => (0.0, 1.0),
+    };
 
     // Painter's algorithm: far triangles first.
     let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
@@ -429,7 +450,7 @@ pub fn mesh_map_png(
         .map_err(|x| err(path, x))?;
     let shade = |v: f64| -> RGBColor {
         if v.is_finite() {
-            let (r, g, b) = viridis((v - vmin) / (vmax - vmin));
+            let (r, g, b) = viridis(((v - vmin) / (vmax - vmin)).clamp(0.0, 1.0));
             RGBColor(r, g, b)
         } else {
             RGBColor(200, 200, 200)

@@ -359,10 +359,11 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
         let up = wcfg.and_then(|w| w.up).unwrap_or(du);
         let png = dir.path(&format!("wetting/{name}.png"));
         let (squares, fraction) = particle_map(&sim, k, elapsed);
-        spatter_io::plot::mesh_map_png(
+        spatter_io::plot::mesh_map_png_range(
             &png,
             &squares,
             &fraction,
+            cfg.output.wetting_cap.map(|cap| [0.0, cap]),
             view,
             up,
             &format!("{name}: fraction of time wet (0–{elapsed:.3} s)"),

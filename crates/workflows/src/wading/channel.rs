@@ -29,6 +29,13 @@ pub struct ChannelSpec {
     pub wall_height_m: f64,
     /// Water depth over the pool floor \[m\] (the study's `x`).
     pub water_depth_m: f64,
+    /// Akinci adhesion factor of the road and the walls (needs surface tension). Default 1.
+    #[serde(default = "one")]
+    pub adhesion: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 impl Validate for ChannelSpec {
@@ -41,6 +48,7 @@ impl Validate for ChannelSpec {
         c.positive("width_m", self.width_m);
         c.positive("wall_height_m", self.wall_height_m);
         c.positive("water_depth_m", self.water_depth_m);
+        c.non_negative("adhesion", self.adhesion);
         if self.water_depth_m > self.pool_depth_m {
             c.fail(
                 "water_depth_m",
@@ -166,6 +174,7 @@ mod tests {
             width_m: 4.0,
             wall_height_m: 1.0,
             water_depth_m: 0.3,
+            adhesion: 1.0,
         }
     }
 

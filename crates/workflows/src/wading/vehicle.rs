@@ -220,6 +220,7 @@ mod tests {
             width_m: 4.0,
             wall_height_m: 1.0,
             water_depth_m: 0.3,
+            adhesion: 1.0,
         }
     }
 
