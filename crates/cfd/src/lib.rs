@@ -3,12 +3,15 @@
 //! * [`grid`] — axes (uniform, geometric, tanh-clustered), the padded layout, metric factors, and the
 //!   3D Cartesian and 2D axisymmetric (r, z) modes;
 //! * [`solid`] — blocked cells from analytic shapes (box, plate, cylinder, pipe wall) and closed STL/OBJ;
+//! * [`regions`] — connected fluid regions and the mass balance each must satisfy;
 //! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
+//! * [`turbulence`] — the standard k–ε model with wall functions;
 //! * [`solver`] — the projection method: Adams–Bashforth predictor, pressure correction, checks;
 //! * [`mg`] — geometric multigrid V-cycle for the pressure operator;
 //! * [`pcg`] — conjugate gradients preconditioned by that V-cycle;
 //! * [`reduce`] — parallel plane loops and thread-count-independent sums;
+//! * [`output`] — cell fields as `.vtr`, probes and slices for pictures;
 //! * [`cavity`] — the lid-driven cavity and the tables of Ghia, Ghia & Shin (1982).
 //!
 //! Everything is SI. The solver works in kinematic pressure p/ρ internally and reports pascals.
@@ -22,10 +25,13 @@ pub mod cavity;
 pub mod grid;
 pub mod mg;
 pub mod momentum;
+pub mod output;
 pub mod pcg;
 pub mod reduce;
+pub mod regions;
 pub mod solid;
 pub mod solver;
+pub mod turbulence;
 pub mod validation;
 
 pub use bc::{Boundary, TimeTable};

@@ -370,6 +370,41 @@ impl Multigrid {
         Multigrid { levels, coarsest, sweeps: 2 }
     }
 
+    /// Padded layouts of the levels [`Multigrid::new`] builds for a grid of `n` cells per axis (computed
+    /// without building anything).
+    pub fn level_layouts(n: [usize; 3]) -> Vec<Layout> {
+        let mut out = vec![Layout::new(n)];
+        loop {
+            let l = *out.last().expect("at least one level");
+            if l.cells() <= COARSEST_CELLS || l.n.iter().all(|&n| n <= 1) {
+                return out;
+            }
+            out.push(Layout::new(l.n.map(|n| if n > 1 { n.div_ceil(2) } else { n })));
+        }
+    }
+
+    /// f64 values a level holds per padded cell: the stencil (3 couplings and the diagonal), the inverse
+    /// diagonal and the work vectors x, b, r and tmp.
+    pub const F64_PER_CELL: usize = 9;
+
+    /// Bytes held on the heap by the levels (the dense coarsest factor included).
+    pub fn heap_bytes(&self) -> u64 {
+        let levels: usize = self
+            .levels
+            .iter()
+            .map(|l| {
+                l.op.a.iter().map(Vec::capacity).sum::<usize>()
+                    + l.op.diag.capacity()
+                    + l.inv_diag.capacity()
+                    + l.x.capacity()
+                    + l.b.capacity()
+                    + l.r.capacity()
+                    + l.tmp.capacity()
+            })
+            .sum();
+        (8 * (levels + self.coarsest.l.capacity() + self.coarsest.cells.capacity())) as u64
+    }
+
     /// The fine operator.
     pub fn op(&self) -> &Stencil {
         &self.levels[0].op

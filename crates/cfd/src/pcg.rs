@@ -53,6 +53,12 @@ impl Pcg {
         Pcg { mg, r: vec![0.0; n], z: vec![0.0; n], p: vec![0.0; n], q: vec![0.0; n], active_count }
     }
 
+    /// Bytes held on the heap (multigrid levels and the four CG vectors).
+    pub fn heap_bytes(&self) -> u64 {
+        self.mg.heap_bytes()
+            + 8 * (self.r.capacity() + self.z.capacity() + self.p.capacity() + self.q.capacity()) as u64
+    }
+
     /// Subtracts the mean over active cells.
     fn project(&self, v: &mut [f64]) {
         let op = self.mg.op();

@@ -72,6 +72,8 @@ pub enum SolidError {
     NotClosed { file: PathBuf, open_edges: usize },
     #[error("solid mesh {file}: encloses a negative volume ({volume} m³): the triangles are wound inside-out; flip their orientation")]
     InsideOut { file: PathBuf, volume: f64 },
+    #[error("solids[{index}]: {source}")]
+    At { index: usize, source: Box<SolidError> },
 }
 
 /// A point-inside test prepared from a [`Solid`].
@@ -147,7 +149,11 @@ pub fn blocked_cells(grid: &Grid, solids: &[Solid]) -> Result<Vec<bool>, SolidEr
     if solids.is_empty() {
         return Ok(out);
     }
-    let tests: Vec<Inside> = solids.iter().map(Inside::new).collect::<Result<_, _>>()?;
+    let tests: Vec<Inside> = solids
+        .iter()
+        .enumerate()
+        .map(|(index, s)| Inside::new(s).map_err(|e| SolidError::At { index, source: Box::new(e) }))
+        .collect::<Result<_, _>>()?;
     for k in 0..l.n[2] {
         for j in 0..l.n[1] {
             for i in 0..l.n[0] {
@@ -195,7 +201,7 @@ mod tests {
         }
         std::fs::write(&p, cube.to_binary_stl()).unwrap();
         let e = blocked_cells(&g, &[Solid::Mesh { file: p.clone(), scale: 1.0 }]).unwrap_err().to_string();
-        assert!(e.contains("inside-out") && e.contains("cube.stl"), "{e}");
+        assert!(e.contains("solids[0]") && e.contains("inside-out") && e.contains("cube.stl"), "{e}");
         cube.triangles.pop();
         std::fs::write(&p, cube.to_binary_stl()).unwrap();
         let e = blocked_cells(&g, &[Solid::Mesh { file: p, scale: 1.0 }]).unwrap_err().to_string();

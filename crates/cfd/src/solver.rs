@@ -63,6 +63,8 @@ pub struct State {
     /// Explicit terms of the previous step, for Adams–Bashforth.
     h_old: [Vec<f64>; 3],
     dt_old: f64,
+    /// k and ε when a turbulence model runs.
+    pub turbulence: Option<crate::turbulence::TurbState>,
 }
 
 /// Why a step failed.
@@ -87,6 +89,8 @@ pub enum FlowError {
     Setup(String),
     #[error("inconsistent boundaries: {0}")]
     Boundaries(String),
+    #[error("mass balance: {0}")]
+    MassBalance(String),
     #[error("the pressure solver did not converge at step {step}: relative residual {residual:.2e} after {iterations} iterations")]
     Pressure { step: u64, residual: f64, iterations: usize },
 }
@@ -110,6 +114,8 @@ pub struct Flow {
     pub blocked: Vec<bool>,
     /// Body acceleration at the velocity nodes \[m/s²\] (actuator disks, particles), if any.
     pub force: Option<[Vec<f64>; 3]>,
+    /// The k–ε model, when enabled ([`Flow::enable_k_epsilon`]).
+    pub turbulence: Option<crate::turbulence::Turbulence>,
     kind: [Vec<u8>; 3],
     /// Nodes set from neighbours after every update: (node, fluid neighbours to mirror).
     solid_nodes: [Vec<(usize, Vec<usize>)>; 3],
@@ -153,6 +159,15 @@ impl Flow {
                 )));
             }
         }
+        if blocked.len() != l.len() {
+            return Err(FlowError::Setup(format!(
+                "{} blocked flags for a grid of {} padded cells (use solid::blocked_cells)",
+                blocked.len(),
+                l.len()
+            )));
+        }
+        let regions = crate::regions::find(&grid, &bc, &blocked);
+        crate::regions::check_mass_balance(&grid, &bc, &regions).map_err(FlowError::MassBalance)?;
         let n = l.len();
         let fluid_cell = |q: [usize; 3]| l.interior(q) && !blocked[l.at(q[0], q[1], q[2])];
         let mut kind = [vec![FIXED; n], vec![FIXED; n], vec![FIXED; n]];
@@ -227,7 +242,15 @@ impl Flow {
         let centre_ops = [0, 1, 2].map(|a| DirOps::centre(&grid.metric[a]));
         let face_ops = [0, 1, 2].map(|a| DirOps::face(&grid.metric[a]));
         let zeros = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let state = State { t: 0.0, step: 0, u: zeros(), p: vec![0.0; n], h_old: zeros(), dt_old: 0.0 };
+        let state = State {
+            t: 0.0,
+            step: 0,
+            u: zeros(),
+            p: vec![0.0; n],
+            h_old: zeros(),
+            dt_old: 0.0,
+            turbulence: None,
+        };
         let mut f = Flow {
             grid,
             fluid,
@@ -236,6 +259,7 @@ impl Flow {
             state,
             blocked,
             force: None,
+            turbulence: None,
             kind,
             solid_nodes,
             outlet_nodes,
@@ -248,6 +272,53 @@ impl Flow {
         };
         f.fill_boundaries(0.0);
         Ok(f)
+    }
+
+    /// Bytes a flow on a grid of `n` cells per axis will hold, computed before allocating anything: per
+    /// padded cell the velocity (3), pressure, the Adams–Bashforth history (3 + 3), φ and the right-hand
+    /// side, the CG vectors (4) and the body force (3, when `with_force`) as f64, three node-kind bytes and
+    /// the blocked flag; with `with_turbulence` the k–ε arrays (k, ε, ν_eff, two work arrays and the two
+    /// wall-function sums as f64, a wall count byte); plus [`Multigrid::F64_PER_CELL`] values per padded
+    /// cell of every multigrid level.
+    /// Small per-boundary lists and the dense coarsest factor (≤ 64² values) are left out; the estimate is
+    /// within a few per cent of [`Flow::heap_bytes`] (tested).
+    pub fn memory_estimate(n: [usize; 3], with_force: bool, with_turbulence: bool) -> u64 {
+        let fine = crate::grid::Layout::new(n).len() as u64;
+        let per_cell =
+            8 * (16 + if with_force { 3 } else { 0 }) + 4 + if with_turbulence { 8 * 7 + 1 } else { 0 };
+        let levels: u64 = Multigrid::level_layouts(n).iter().map(|l| l.len() as u64).sum();
+        fine * per_cell + levels * 8 * Multigrid::F64_PER_CELL as u64
+    }
+
+    /// Bytes this flow holds on the heap in its fields, work vectors and pressure solver.
+    pub fn heap_bytes(&self) -> u64 {
+        let f64s = |v: &[Vec<f64>; 3]| v.iter().map(Vec::capacity).sum::<usize>();
+        let st = &self.state;
+        let mut n = f64s(&st.u) + st.p.capacity() + f64s(&st.h_old) + f64s(&self.h_new);
+        n += self.phi.capacity() + self.rhs.capacity();
+        n += self.force.as_ref().map_or(0, f64s);
+        if let Some(t) = &self.state.turbulence {
+            n += t.k.capacity() + t.eps.capacity();
+        }
+        let turb = self.turbulence.as_ref().map_or(0, |t| t.heap_bytes());
+        let bytes = self.kind.iter().map(Vec::capacity).sum::<usize>() + self.blocked.capacity();
+        let lists: usize = (0..3)
+            .map(|a| {
+                self.outlet_nodes[a].capacity() * 16
+                    + self.solid_nodes[a].iter().map(|(_, v)| 32 + 8 * v.capacity()).sum::<usize>()
+            })
+            .sum();
+        (8 * n + bytes + lists) as u64 + self.pcg.heap_bytes() + turb
+    }
+
+    /// Switches on the standard k–ε model with wall functions ([`crate::turbulence`]), starting from the
+    /// inlet turbulence everywhere. Call before the first step.
+    pub fn enable_k_epsilon(&mut self, model: crate::turbulence::KEpsilon) {
+        let mut t = crate::turbulence::Turbulence::new(model, &self.grid, &self.bc, &self.blocked);
+        let st = t.initial_state(&self.grid, &self.bc);
+        t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, &st);
+        self.state.turbulence = Some(st);
+        self.turbulence = Some(t);
     }
 
     /// Number of multigrid levels of the pressure solver.
@@ -331,8 +402,10 @@ impl Flow {
         }
     }
 
-    /// Explicit terms H of component `A` at its active nodes into `out`.
-    fn explicit_terms<const A: usize>(&self, out: &mut [f64]) {
+    /// Explicit terms H of component `A` at its active nodes into `out`; with `TURB` the viscosity of
+    /// each control-volume face is the effective viscosity of the turbulence model (the laminar path
+    /// keeps its arithmetic, so laminar results are unchanged bit for bit).
+    fn explicit_terms<const A: usize, const TURB: bool>(&self, out: &mut [f64]) {
         let l = self.grid.layout;
         let s = l.s;
         let u = &self.state.u;
@@ -345,6 +418,10 @@ impl Flow {
         let hoop = A == 0 && self.grid.mode == Mode::Axisymmetric;
         let rf = &self.grid.metric[0].xf;
         let force = self.force.as_ref().map(|f| &f[A]);
+        let nu_eff: &[f64] = match (&self.turbulence, TURB) {
+            (Some(t), true) => &t.nu_eff,
+            _ => &[],
+        };
         for_planes(&l, out, |k, plane| {
             let base = k * s[2];
             for j in GHOST..GHOST + l.n[1] {
@@ -381,12 +458,33 @@ impl Flow {
                             face_value(scheme, pe, pc, pw)
                         };
                         conv += fp * vp * (plus - pc) - fm * vm * (minus - pc);
-                        diff += fp * o.hp[qd] * (pe - pc) - fm * o.hm[qd] * (pc - pw);
+                        if TURB {
+                            // Face viscosities: cell centres along A, edge averages across.
+                            let sa = s[A];
+                            let (np, nm) = if d == A {
+                                (nu_eff[c + sa], nu_eff[c])
+                            } else {
+                                (
+                                    0.25 * (nu_eff[c]
+                                        + nu_eff[c + sa]
+                                        + nu_eff[c + sd]
+                                        + nu_eff[c + sa + sd]),
+                                    0.25 * (nu_eff[c]
+                                        + nu_eff[c + sa]
+                                        + nu_eff[c - sd]
+                                        + nu_eff[c + sa - sd]),
+                                )
+                            };
+                            diff += fp * o.hp[qd] * (pe - pc) * np - fm * o.hm[qd] * (pc - pw) * nm;
+                        } else {
+                            diff += fp * o.hp[qd] * (pe - pc) - fm * o.hm[qd] * (pc - pw);
+                        }
                     }
-                    let mut h = nu * diff - conv;
+                    let mut h = if TURB { diff - conv } else { nu * diff - conv };
                     if hoop {
                         let r = rf[i];
-                        h -= nu * pc / (r * r);
+                        let nu_node = if TURB { 0.5 * (nu_eff[c] + nu_eff[c + 1]) } else { nu };
+                        h -= nu_node * pc / (r * r);
                     }
                     if let Some(f) = force {
                         h += f[c];
@@ -402,10 +500,18 @@ impl Flow {
         let l = self.grid.layout;
         let s = l.s;
         let mut h_new = std::mem::take(&mut self.h_new);
-        self.explicit_terms::<0>(&mut h_new[0]);
-        self.explicit_terms::<1>(&mut h_new[1]);
-        if self.grid.mode == Mode::Cartesian {
-            self.explicit_terms::<2>(&mut h_new[2]);
+        if self.turbulence.is_some() {
+            self.explicit_terms::<0, true>(&mut h_new[0]);
+            self.explicit_terms::<1, true>(&mut h_new[1]);
+            if self.grid.mode == Mode::Cartesian {
+                self.explicit_terms::<2, true>(&mut h_new[2]);
+            }
+        } else {
+            self.explicit_terms::<0, false>(&mut h_new[0]);
+            self.explicit_terms::<1, false>(&mut h_new[1]);
+            if self.grid.mode == Mode::Cartesian {
+                self.explicit_terms::<2, false>(&mut h_new[2]);
+            }
         }
         let (c1, c0) = if self.state.step == 0 || self.state.dt_old <= 0.0 {
             (1.0, 0.0)
@@ -501,6 +607,18 @@ impl Flow {
             }
         });
         self.fill_boundaries(t_new);
+        if let (Some(turb), Some(ts)) = (self.turbulence.as_mut(), self.state.turbulence.as_mut()) {
+            turb.step(
+                &self.grid,
+                &self.bc,
+                &self.blocked,
+                self.fluid.viscosity,
+                &self.state.u,
+                t_new,
+                dt,
+                ts,
+            );
+        }
         self.h_new = std::mem::replace(&mut self.state.h_old, h_new);
         self.state.dt_old = dt;
         self.state.t = t_new;
@@ -564,7 +682,22 @@ impl Flow {
             (0..dims).map(|a| u[a][c].abs().max(u[a][c - l.s[a]].abs()) / m[a].d[q[a]]).sum::<f64>()
         });
         let h2 = (0..dims).map(|a| 1.0 / (self.grid.axes[a].min_width().powi(2))).sum::<f64>();
-        let diff = 0.9 / (4.0 * self.fluid.viscosity * h2);
+        let mut diff = 0.9 / (4.0 * self.fluid.viscosity * h2);
+        if let Some(t) = &self.turbulence {
+            // The largest ν_eff Σ 1/Δx² over the cells (ghosts included: they hold the wall viscosity).
+            let nu_rate = max_interior(&l, |c| {
+                let q = l.coords(c);
+                let inv: f64 = (0..dims).map(|a| 1.0 / m[a].d[q[a]].powi(2)).sum();
+                let mut v = t.nu_eff[c];
+                for a in 0..dims {
+                    v = v
+                        .max(0.5 * (t.nu_eff[c] + t.nu_eff[c + l.s[a]]))
+                        .max(0.5 * (t.nu_eff[c] + t.nu_eff[c - l.s[a]]));
+                }
+                v * inv
+            });
+            diff = diff.min(0.9 / (4.0 * nu_rate));
+        }
         let conv = if rate > 0.0 { courant / rate } else { f64::INFINITY };
         dt_max.min(diff).min(conv)
     }
@@ -583,6 +716,11 @@ impl Flow {
 
     /// Velocity at point x by trilinear interpolation of each staggered component \[m/s\]; `None` outside.
     pub fn velocity_at(&self, x: [f64; 3]) -> Option<[f64; 3]> {
+        self.velocity_at_nodes(&self.state.u, x)
+    }
+
+    /// Like [`Flow::velocity_at`] for other velocity nodes `nodes` on this grid (an earlier state).
+    pub fn velocity_at_nodes(&self, nodes: &[Vec<f64>; 3], x: [f64; 3]) -> Option<[f64; 3]> {
         let l = self.grid.layout;
         for a in 0..3 {
             if !(x[a] >= self.grid.axes[a].lo() && x[a] <= self.grid.axes[a].hi()) {
@@ -603,7 +741,7 @@ impl Flow {
                 base[a] = p;
                 w[a] = t;
             }
-            let u = &self.state.u[comp];
+            let u = &nodes[comp];
             let mut v = 0.0;
             for dk in 0..2 {
                 for dj in 0..2 {
@@ -648,7 +786,15 @@ impl Flow {
                 state.p.len()
             )));
         }
+        if self.turbulence.is_some() != state.turbulence.is_some() {
+            return Err(FlowError::Setup(
+                "the checkpoint was written with a different turbulence model than this flow uses".into(),
+            ));
+        }
         self.state = state;
+        if let (Some(t), Some(ts)) = (self.turbulence.as_mut(), self.state.turbulence.as_ref()) {
+            t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, ts);
+        }
         Ok(())
     }
 }
@@ -687,6 +833,32 @@ mod tests {
 
     fn bits(v: &[Vec<f64>; 3]) -> Vec<u64> {
         v.iter().flat_map(|c| c.iter().map(|x| x.to_bits())).collect()
+    }
+
+    #[test]
+    fn memory_estimate_matches_what_the_solver_allocates() {
+        use crate::grid::{Axis, Grid, Mode};
+        use crate::{Boundary, Flow, Fluid};
+        for (n, mode) in [([40, 30, 20], Mode::Cartesian), ([48, 96, 1], Mode::Axisymmetric)] {
+            let ax = |a: usize| Axis::uniform(0.0, 1.0, n[a]).unwrap();
+            let g = Grid::new([ax(0), ax(1), ax(2)], mode).unwrap();
+            let wall = Boundary::Wall { velocity_m_s: [0.0; 3] };
+            let mut bc: [Boundary; 6] = std::array::from_fn(|_| wall.clone());
+            if mode == Mode::Axisymmetric {
+                bc[0] = Boundary::Axis;
+                bc[4] = Boundary::Slip;
+                bc[5] = Boundary::Slip;
+            }
+            let blocked = vec![false; g.layout.len()];
+            let mut f =
+                Flow::new(g, Fluid { density: 1.0, viscosity: 1e-3 }, bc, blocked, Numerics::default())
+                    .unwrap();
+            let l = f.grid.layout.len();
+            f.force = Some([vec![0.0; l], vec![0.0; l], vec![0.0; l]]);
+            f.enable_k_epsilon(crate::turbulence::KEpsilon::standard(0.05, 0.1));
+            let (est, real) = (Flow::memory_estimate(n, true, true) as f64, f.heap_bytes() as f64);
+            assert!((est / real - 1.0).abs() < 0.05, "{n:?}: estimate {est} B, allocated {real} B");
+        }
     }
 
     #[test]

@@ -23,6 +23,7 @@ pub fn validation_cases() -> Vec<Case> {
         Case { name: "cfd_channel_poiseuille", run: channel },
         Case { name: "cfd_pipe_axisymmetric", run: pipe },
         Case { name: "cfd_taylor_green_order", run: taylor_green },
+        Case { name: "cfd_pipe_k_epsilon_friction", run: turbulent_pipe },
     ]
 }
 
@@ -147,6 +148,97 @@ fn channel(quick: bool) -> Vec<Check> {
         Check::relative(case, "dp/dx = -12 mu U / H^2 [Pa/m]", -1.2, dpdx, 0.02, WHITE),
         Check::absolute(case, "net outflow [m^3/s]", 0.0, f.net_outflow(), 1e-9, "continuity"),
     ]
+}
+
+/// Darcy friction factor of a smooth pipe from the Colebrook equation 1/√f = −2 log₁₀(2.51/(Re √f))
+/// (Colebrook 1939), solved by fixed-point iteration.
+pub fn colebrook_smooth(re: f64) -> f64 {
+    let mut x = 8.0; // 1/√f
+    for _ in 0..50 {
+        x = -2.0 * (2.51 * x / re).log10();
+    }
+    1.0 / (x * x)
+}
+
+/// A developed turbulent pipe flow with the k–ε model and wall functions, in the axisymmetric mode:
+/// D = 1 m, U = 1 m/s, Re = 5·10⁴ (quick: 2·10⁴), uniform inlet with 5 % intensity; the friction factor
+/// f = (−dp/dz) D / (½ ρ U²) from the pressure drop between 30 and 40 D against Colebrook's smooth-pipe
+/// value and Blasius f = 0.316 Re^(−1/4) (Blasius 1913). The first cell centre sits at y+ ≈ 30–60.
+pub fn turbulent_pipe_friction(
+    re: f64,
+    nr: usize,
+    nz: usize,
+    length: f64,
+) -> Result<(f64, f64), crate::FlowError> {
+    let grid = Grid::new(
+        [Axis::uniform(0.0, 0.5, nr)?, Axis::uniform(0.0, length, nz)?, Axis::uniform(0.0, 1.0, 1)?],
+        Mode::Axisymmetric,
+    )
+    .map_err(|e| crate::FlowError::Setup(e.to_string()))?;
+    let bc = [
+        Boundary::Axis,
+        Boundary::Wall { velocity_m_s: [0.0; 3] },
+        Boundary::Inlet { velocity_m_s: [0.0, 1.0, 0.0], table: Default::default() },
+        Boundary::Outlet { pressure_pa: 0.0 },
+        Boundary::Slip,
+        Boundary::Slip,
+    ];
+    let n = grid.layout.len();
+    let mut f = Flow::new(
+        grid,
+        Fluid { density: 1.0, viscosity: 1.0 / re },
+        bc,
+        vec![false; n],
+        Numerics::default(),
+    )?;
+    f.enable_k_epsilon(crate::turbulence::KEpsilon::standard(0.05, 0.07));
+    // Steady to 10⁻⁴ m/s per time unit, at most 4 flow-throughs.
+    cavity::run_to_steady(&mut f, 1e-4, 4.0 * length)?;
+    let p_at = |z: f64| {
+        let j = f.grid.axes[1].locate(z);
+        // Area-weighted mean pressure over the section.
+        let (mut pa, mut a) = (0.0, 0.0);
+        for i in 0..nr {
+            let r = f.grid.axes[0].centre(i);
+            pa += f.cell_pressure(i, j, 0) * r;
+            a += r;
+        }
+        (f.grid.axes[1].centre(j), pa / a)
+    };
+    let (z1, p1) = p_at(length - 20.0);
+    let (z2, p2) = p_at(length - 10.0);
+    let friction = -(p2 - p1) / (z2 - z1) / 0.5;
+    // Centreline over mean velocity, for the log.
+    let uc = f.velocity_at([0.0, length - 10.0, 0.5]).map_or(f64::NAN, |v| v[1]);
+    Ok((friction, uc))
+}
+
+const COLEBROOK: &str = "Colebrook (1939) smooth pipe; Blasius (1913) f = 0.316 Re^-0.25";
+
+fn turbulent_pipe(quick: bool) -> Vec<Check> {
+    let case = "cfd_pipe_k_epsilon_friction";
+    let (re, nr, nz) = if quick { (2e4, 8, 100) } else { (5e4, 12, 100) };
+    match turbulent_pipe_friction(re, nr, nz, 50.0) {
+        Ok((f, _)) => vec![
+            Check::relative(
+                case,
+                format!("Darcy f at Re = {re:e}, {nr}x{nz}, vs Colebrook [-]"),
+                colebrook_smooth(re),
+                f,
+                0.10,
+                COLEBROOK,
+            ),
+            Check::relative(
+                case,
+                format!("Darcy f at Re = {re:e} vs Blasius [-]"),
+                0.316 * re.powf(-0.25),
+                f,
+                0.10,
+                COLEBROOK,
+            ),
+        ],
+        Err(e) => vec![Check::absolute(case, format!("run failed: {e}"), 0.0, f64::NAN, 0.0, COLEBROOK)],
+    }
 }
 
 fn pipe(quick: bool) -> Vec<Check> {
@@ -345,5 +437,84 @@ mod tests {
     #[test]
     fn taylor_green_decay_converges_at_second_order() {
         assert_all(taylor_green(true));
+    }
+}
+
+#[cfg(test)]
+mod turbulent_tests {
+    use super::*;
+
+    #[test]
+    fn colebrook_matches_the_moody_chart() {
+        // Smooth-pipe values of the Moody chart (Moody 1944): f(10⁴) ≈ 0.0309, f(10⁵) ≈ 0.0180.
+        assert!((colebrook_smooth(1e4) - 0.0309).abs() < 3e-4, "{}", colebrook_smooth(1e4));
+        assert!((colebrook_smooth(1e5) - 0.0180).abs() < 2e-4, "{}", colebrook_smooth(1e5));
+    }
+
+    /// Re = 2·10⁴ on 8 × 100 cells (y+ ≈ 35): about 30 s in a debug build.
+    #[test]
+    fn k_epsilon_pipe_friction_factor_within_ten_percent_of_colebrook_and_blasius() {
+        let checks = turbulent_pipe(true);
+        for c in &checks {
+            eprintln!("{} | {} | ref {} | ours {}", c.case, c.quantity, c.reference, c.ours);
+            assert!(c.passed(), "{c:?}");
+        }
+    }
+
+    #[test]
+    fn k_epsilon_is_thread_count_independent_and_resumes_bit_for_bit() {
+        let build = || {
+            let grid = Grid::new(
+                [
+                    Axis::uniform(0.0, 0.5, 8).unwrap(),
+                    Axis::uniform(0.0, 10.0, 40).unwrap(),
+                    Axis::uniform(0.0, 1.0, 1).unwrap(),
+                ],
+                Mode::Axisymmetric,
+            )
+            .unwrap();
+            let bc = [
+                Boundary::Axis,
+                Boundary::Wall { velocity_m_s: [0.0; 3] },
+                Boundary::Inlet { velocity_m_s: [0.0, 1.0, 0.0], table: Default::default() },
+                Boundary::Outlet { pressure_pa: 0.0 },
+                Boundary::Slip,
+                Boundary::Slip,
+            ];
+            let n = grid.layout.len();
+            let mut f = Flow::new(
+                grid,
+                Fluid { density: 1.0, viscosity: 5e-5 },
+                bc,
+                vec![false; n],
+                Numerics::default(),
+            )
+            .unwrap();
+            f.enable_k_epsilon(crate::turbulence::KEpsilon::standard(0.05, 0.07));
+            f
+        };
+        let run = |threads: usize, split: Option<usize>| {
+            rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
+                let mut f = build();
+                let dir = tempfile::tempdir().unwrap();
+                let path = dir.path().join("checkpoint.bin");
+                for s in 0..30 {
+                    if Some(s) == split {
+                        spatter_io::checkpoint::save(&path, 7, &f.state).unwrap();
+                        f = build();
+                        f.restore(spatter_io::checkpoint::load(&path, 7).unwrap()).unwrap();
+                    }
+                    let dt = f.stable_dt(0.5, 0.1);
+                    f.step(dt).unwrap();
+                }
+                let t = f.state.turbulence.clone().unwrap();
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                (bits(&f.state.u[1]), bits(&f.state.p), bits(&t.k), bits(&t.eps))
+            })
+        };
+        let straight = run(1, None);
+        assert!(straight.2.iter().any(|&k| f64::from_bits(k) > 0.0));
+        assert_eq!(run(2, None), straight, "2 threads give the same bits as 1");
+        assert_eq!(run(1, Some(13)), straight, "resume changes nothing");
     }
 }

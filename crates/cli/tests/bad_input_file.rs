@@ -37,6 +37,15 @@ fn missing_kind() {
 }
 
 #[test]
+fn a_study_file_given_as_a_scenario_points_to_sweep() {
+    rejects(
+        "study.toml",
+        b"base = \"snow.toml\"\n[[vary]]\nkey = \"grid.diameters\"\nvalues = [4, 8]\n",
+        &["study.toml:1:1", "parameter study", "spatter sweep"],
+    );
+}
+
+#[test]
 fn kind_of_wrong_type() {
     rejects("kind42.toml", b"kind = 42\n", &["kind42.toml:1:1", "kind = 42 must be a string"]);
 }

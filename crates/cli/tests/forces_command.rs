@@ -18,7 +18,7 @@ fn forces_prints_the_ranking_and_writes_csv() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&o.stderr));
-    // Critical drag coefficient A_H/F_D0 = 9.90 for every diameter (digest seed_003 §6.2).
+    // Critical drag coefficient A_H/F_D0 = 9.90 for every diameter (Jasion 2013, eq. 6.7–6.10).
     let line = stdout.lines().find(|l| l.starts_with("A_H/F_D0")).expect("A_H/F_D0 row");
     assert_eq!(line.matches("9.9000e0").count(), 3, "{line}");
     assert!(out.join("force_ranking.csv").is_file() && out.join("force_magnitudes.csv").is_file());

@@ -228,6 +228,23 @@ fn wading_resumes_bit_for_bit() {
     stop_and_resume(&s, 5, "wading");
 }
 
+#[test]
+fn flow_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    // The cavity example on a 16² grid for 1 s, without the early steady stop.
+    let text = std::fs::read_to_string(examples.join("flow_cavity.toml"))
+        .unwrap()
+        .replace("cells = 48, cluster = 0.5", "cells = 16")
+        .replace("end_time_s = 40.0", "end_time_s = 1.0")
+        .replace("steady_rate_m_s2 = 1e-4", "")
+        .replace("field_interval_s = 5.0", "field_interval_s = 0.25")
+        .replace("sample_interval_s = 0.5", "sample_interval_s = 0.05");
+    assert!(text.contains("cells = 16") && text.contains("end_time_s = 1.0"));
+    let s = write(dir.path(), "flow.toml", text.as_bytes());
+    stop_and_resume(&s, 40, "flow");
+}
+
 /// A real SIGTERM (what a batch scheduler sends) to a child `spatter run`: it finishes the step, writes
 /// a checkpoint, exits 130, and `--resume` completes the run with the same files as an uninterrupted one.
 #[cfg(unix)]

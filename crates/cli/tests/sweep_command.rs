@@ -197,3 +197,43 @@ fn reports_open_in_a_browser_with_every_picture() {
         );
     }
 }
+
+/// A deposition study whose two cases differ only in the mass each parcel carries (same seeds, so the same
+/// impacts): the study redraws both plate maps on one colour scale, whose top is the heavier case's peak
+/// mass per area — four times the lighter case's.
+#[test]
+fn maps_of_every_case_are_redrawn_on_one_colour_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let ex = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").canonicalize().unwrap();
+    let base = std::fs::read_to_string(ex.join("deposition_stagnation_plate.toml"))
+        .unwrap()
+        .replace("\"deposition_plate.stl\"", &format!("{:?}", ex.join("deposition_plate.stl")))
+        .replace("\"deposition_regime_map.json\"", &format!("{:?}", ex.join("deposition_regime_map.json")))
+        .replace("parcels = 100000", "parcels = 3000")
+        .replace("duration_s = 1.0", "duration_s = 0.3");
+    write(dir.path(), "base.toml", base.as_bytes());
+    let study = write(
+        dir.path(),
+        "study.toml",
+        b"base = \"base.toml\"\n[[vary]]\nkey = \"injectors[0].mass_per_parcel_kg\"\nvalues = [1e-9, 4e-9]\n",
+    );
+    let out = dir.path().join("s");
+    ok(&sweep(&[], &study, &out, None));
+    let peak = |case: &str| {
+        let vtu = spatter_io::vtu::read(&out.join("cases").join(case).join("bodies/plate.vtu")).unwrap();
+        vtu.cell_data["mass_per_area_kg_m2"].1.iter().copied().fold(0.0, f64::max)
+    };
+    let (light, heavy) = (peak("case_00000"), peak("case_00001"));
+    assert!(light > 0.0, "the plate must receive snow");
+    assert!((heavy / light - 4.0).abs() < 1e-9, "same impacts, four times the mass: {light} {heavy}");
+    for case in ["case_00000", "case_00001"] {
+        assert!(
+            out.join("gallery/plate_deposit").join(format!("{case}.png")).is_file(),
+            "{case} map missing"
+        );
+    }
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("plate deposit: every case on one colour scale"), "gallery heading missing");
+    let scale = format!("Colour scale 0 to {}", spatter_io::plot::tick_label(heavy));
+    assert!(report.contains(&scale), "expected `{scale}` in the report");
+}

@@ -1,6 +1,6 @@
 //! Elastic materials and the effective properties of a contacting pair.
 //!
-//! Definitions follow Chung & Ooi (2011), Granular Matter 13:643–656, §2 (also `VERIFICATION.md`):
+//! Definitions follow Chung & Ooi (2011), Granular Matter 13:643–656, §2:
 //!
 //! * E* = [(1−ν₁²)/E₁ + (1−ν₂²)/E₂]⁻¹
 //! * G* = [(2−ν₁)/G₁ + (2−ν₂)/G₂]⁻¹ with G = E / (2(1+ν))  (Mindlin; identical to LIGGGHTS'
@@ -130,7 +130,7 @@ mod tests {
 
     #[test]
     fn snow_seed_effective_moduli() {
-        // Reference: digests/seed_000_snow_dem.md §3.5 (computed from thesis Table 2):
+        // Reference: computed from Lind (2017) Table 2:
         // ice–ABS E* = 1.88329e9 Pa, G* = 3.7323e8 Pa; ice–ice E* = 5.42095e9 Pa. Tolerance 1e-5 relative.
         let ice = Material::new(9.8e9, 0.31, 920.0).unwrap();
         let abs = Material::new(2.0e9, 0.35, 1100.0).unwrap();

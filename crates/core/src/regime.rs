@@ -1,7 +1,7 @@
 //! Stick/bounce wall rules produced by the snow regime-map workflow and consumed by particle trackers.
 //!
 //! The file format is JSON (`regime_map.json`, schema tag [`RegimeMap::SCHEMA`]). The rule is the one of
-//! the snow thesis (`digests/seed_000_snow_dem.md` §5.3): a particle of diameter d hitting the wall with
+//! the snow thesis (Lind 2017): a particle of diameter d hitting the wall with
 //! normal speed v_n sticks when v_n < v_crit(d); otherwise it bounces.
 
 use serde::{Deserialize, Serialize};

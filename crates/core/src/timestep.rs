@@ -5,8 +5,8 @@ use std::f64::consts::PI;
 /// Rayleigh-wave time Δt_R = π R √(ρ/G) / (0.1631 ν + 0.8766) \[s\] for a sphere of radius `radius` \[m\],
 /// density \[kg/m³\], shear modulus \[Pa\] and Poisson ratio.
 ///
-/// Reference: LIGGGHTS `fix check/timestep/gran` documentation; snow thesis Eq. 25
-/// (`digests/seed_000_snow_dem.md` §2.7).
+/// Reference: LIGGGHTS `fix check/timestep/gran` documentation; snow thesis (Lind 2017)
+/// Eq. 25.
 pub fn rayleigh_time(radius: f64, density: f64, shear_modulus: f64, poisson_ratio: f64) -> f64 {
     PI * radius * (density / shear_modulus).sqrt() / (0.1631 * poisson_ratio + 0.8766)
 }
@@ -14,7 +14,7 @@ pub fn rayleigh_time(radius: f64, density: f64, shear_modulus: f64, poisson_rati
 /// Hertz contact duration t_c = 2.868 (m*² / (R* E*² v))^{1/5} \[s\] of an elastic impact at approach
 /// speed `speed` \[m/s\].
 ///
-/// Reference: Chung & Ooi (2011) / `VERIFICATION.md` (coefficient 2.868; the snow thesis Eq. 26 rounds it
+/// Reference: Chung & Ooi (2011) (coefficient 2.868; the snow thesis Eq. 26 rounds it
 /// to 2.87).
 pub fn hertz_time(effective_mass: f64, effective_radius: f64, effective_modulus: f64, speed: f64) -> f64 {
     2.868
@@ -34,8 +34,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn rayleigh_time_matches_snow_digest() {
-        // digests/seed_000_snow_dem.md §2.7: ice, G = 3.7405 GPa, ν = 0.31, ρ = 920:
+    fn rayleigh_time_matches_snow_thesis() {
+        // Lind (2017): ice, G = 3.7405 GPa, ν = 0.31, ρ = 920:
         // Δt_R = 8.402 ns at d = 10 µm. Tolerance 1e-3 relative (4 printed digits).
         let g = 9.8e9 / (2.0 * 1.31);
         let t = rayleigh_time(5e-6, 920.0, g, 0.31);
@@ -44,7 +44,7 @@ mod tests {
 
     #[test]
     fn hertz_time_matches_chung_ooi_glass() {
-        // VERIFICATION.md, Chung & Ooi test 1, glass: t_c = 40.34 µs (1 %).
+        // Chung & Ooi (2011) test 1, glass: t_c = 40.34 µs (1 %).
         // Two spheres R = 0.01, v = ±10 → approach speed 20 m/s, R* = 0.005, m* = m/2.
         let e_star = 48e9 / (2.0 * (1.0 - 0.04));
         let m = 2800.0 * 4.0 / 3.0 * PI * 1e-6;

@@ -1,6 +1,6 @@
 //! The DEM benchmark outside the CLI, with the LAMMPS data file export used by `bench/dem/compare.sh`:
 //!
-//! `cargo run --release -p spatter-dem --example dem_bench -- [--quick] [--lammps-data box.data]
+//! `cargo run --release -p spatter-dem --example dem_bench -- [--quick] [--clumps] [--lammps-data box.data]
 //!  [--steps N] [--threads-only 1] [--per-contact | --no-energy] [--chunks N [--chunk-steps K]]`
 //! With `--chunks`, prints the fastest and the median chunk; `DEM_BENCH_TRACE=1` lists every chunk time
 //! on stderr (bursts of slow steps are the shared host, not the code).
@@ -19,6 +19,35 @@ fn main() {
     } else {
         Some(spatter_dem::EnergyMethod::Residual)
     };
+    if args.iter().any(|a| a == "--clumps") {
+        // The sphere box and the clump box with the same number of member spheres, 1 and 2 threads.
+        let case = if quick { BoxCase::quick() } else { BoxCase::full() };
+        let steps: u64 =
+            flag("--steps").map(|s| s.parse().expect("--steps N")).unwrap_or(if quick { 200 } else { 400 });
+        let settle_steps: u64 = flag("--settle")
+            .map(|s| s.parse().expect("--settle N"))
+            .unwrap_or(if quick { 2000 } else { 4000 });
+        let mut sim = dense_box(&case);
+        settle(&mut sim, settle_steps).expect("settling");
+        let state = sim.state();
+        let one = time_run(&case, &state, 1, steps, true, energy).expect("1 thread");
+        let two = time_run(&case, &state, 2, steps, true, energy).expect("2 threads");
+        println!(
+            "spheres: {} ; 1 thread {:.3e}, 2 threads {:.3e} particle-steps/s",
+            sim.particles.len(),
+            one.rate(),
+            two.rate()
+        );
+        let clump_settle: u64 = flag("--clump-settle")
+            .map(|s| s.parse().expect("--clump-settle N"))
+            .unwrap_or(spatter_dem::bench::CLUMP_SETTLE_STEPS);
+        for line in spatter_dem::bench::bench_clumps(&case, clump_settle, steps, one.rate(), two.rate())
+            .expect("clumps")
+        {
+            println!("{line}");
+        }
+        return;
+    }
     if let Some(path) = flag("--lammps-data") {
         // Settle, export for LAMMPS, and time the same state here.
         let case = if quick { BoxCase::quick() } else { BoxCase::full() };

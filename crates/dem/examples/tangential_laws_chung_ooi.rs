@@ -1,5 +1,5 @@
 //! Chung & Ooi (2011) tests 4 (Al oxide, 5°, 10°, 20°) and 6 (Al alloy, x = 1.21 … 11.9) in the sticking
-//! regime for every tangential law and damping option, against the reference of `VERIFICATION.md`;
+//! regime for every tangential law and damping option, against the reference of Chung & Ooi (2011);
 //! then the whole test 6 curve (Al alloy and nylon) with the default law and under the elastic-cap
 //! convention, against the curve digitised from the paper's figure. The tables behind docs/dem.md §4.
 //! Run: `cargo run --release -p spatter-dem --example tangential_laws_chung_ooi` (about a minute).
@@ -83,7 +83,7 @@ fn main() {
 
     // The whole test 6 curve. Reference: digitised from Chung & Ooi (2011)'s figure for test 6 (the points
     // of the public Kratos DEM benchmark data, `benchmark6_graph1.dat`); the four points of
-    // `VERIFICATION.md` are among them. The nylon points lie within 0.03 of these x.
+    // Chung & Ooi (2011) are among them. The nylon points lie within 0.03 of these x.
     let xs = [
         0.176, 0.551, 0.969, 1.189, 1.454, 1.740, 2.093, 2.489, 2.996, 3.634, 4.515, 5.749, 7.819, 11.894,
         24.01,

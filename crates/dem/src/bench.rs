@@ -126,6 +126,107 @@ pub fn dense_box(case: &BoxCase) -> Simulation<HertzMindlin> {
     sim
 }
 
+/// The tetrahedral 4-sphere clump of the clump benchmark: members of radius `r` on the corners of a
+/// regular tetrahedron of edge 1.6 r (overlapping).
+pub fn tetra_clump(r: f64) -> crate::clump::ClumpTemplate {
+    let a = 0.8 * r / std::f64::consts::SQRT_2;
+    let corners = [
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(1.0, -1.0, -1.0),
+        Vec3::new(-1.0, 1.0, -1.0),
+        Vec3::new(-1.0, -1.0, 1.0),
+    ];
+    let spheres: Vec<(Vec3, f64)> = corners.iter().map(|&c| (c * a, r)).collect();
+    crate::clump::ClumpTemplate::from_spheres("tetra4", &spheres)
+}
+
+/// The clump case: as many member spheres as the sphere box has spheres, in 4-sphere clumps
+/// ([`tetra_clump`], the same radius, material and contact law), on a cubic lattice with random seeded
+/// orientations, 6 layers high, started at 0.2 m/s downwards (to settle in about as many steps as the
+/// sphere box). Returns the
+/// simulation and the box extent.
+pub fn clump_box(case: &BoxCase) -> (Simulation<HertzMindlin>, Vec3) {
+    let mat = case.material();
+    let mats = vec![mat.clone(), mat];
+    let pairs: PairTable<_> = uniform_pairs(&mats, case.friction, case.restitution);
+    let mut sim = Simulation::new(HertzMindlin::default(), mats, pairs, case.dt, Settings::default());
+    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
+    let t = sim.add_template(tetra_clump(case.radius));
+    let rb = sim.templates()[t].bounding_radius();
+    let spacing = 2.0 * rb + 0.1 * case.radius;
+    let bodies = case.count() / 4;
+    let layers = 6usize;
+    let per_side = (bodies as f64 / layers as f64).sqrt().ceil() as usize;
+    let side = per_side as f64 * spacing;
+    let l = Vec3::new(side, side, (bodies.div_ceil(per_side * per_side)) as f64 * spacing + 4.0 * rb);
+    let planes =
+        [(Vec3::ZERO, Vec3::Z), (Vec3::ZERO, Vec3::X), (l, -Vec3::X), (Vec3::ZERO, Vec3::Y), (l, -Vec3::Y)];
+    for (k, (p, n)) in planes.into_iter().enumerate() {
+        sim.add_wall(Wall {
+            name: format!("wall{k}"),
+            shape: WallShape::Plane(Plane::new(p, n)),
+            material: 1,
+            motion: Motion::Fixed,
+        });
+    }
+    let mut rng = seeded(2025, 0);
+    let mut placed = 0;
+    'fill: for k in 0.. {
+        for j in 0..per_side {
+            for i in 0..per_side {
+                if placed == bodies {
+                    break 'fill;
+                }
+                let x = Vec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * spacing;
+                let axis = Vec3::new(
+                    rng.random::<f64>() - 0.5,
+                    rng.random::<f64>() - 0.5,
+                    rng.random::<f64>() - 0.5,
+                );
+                let q = spatter_core::Quat::from_axis_angle(
+                    axis.try_normalize().unwrap_or(Vec3::Z),
+                    rng.random::<f64>() * std::f64::consts::TAU,
+                );
+                let b = crate::clump::NewBody {
+                    vel: Vec3::new(0.0, 0.0, -0.2),
+                    ..crate::clump::NewBody::at(x, q)
+                };
+                sim.add_clump(t, 0, b).expect("benchmark clump");
+                placed += 1;
+            }
+        }
+    }
+    (sim, l)
+}
+
+/// Settling steps of the clump box before timing.
+pub const CLUMP_SETTLE_STEPS: u64 = 30_000;
+
+/// Times `steps` steps of the clump box restored from `state` on `threads` threads.
+pub fn time_clump_run(
+    case: &BoxCase,
+    state: &SimState<<HertzMindlin as crate::contact::ContactLaw>::State>,
+    threads: usize,
+    steps: u64,
+) -> Result<Timing, DemError> {
+    let (mut sim, _) = clump_box(case);
+    sim.energy_method = crate::sim::EnergyMethod::Residual;
+    sim.restore(state.clone()).map_err(DemError::Resume)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| DemError::Config { key: "threads".into(), message: e.to_string() })?;
+    let r0 = sim.rebuild_count();
+    let t = Instant::now();
+    pool.install(|| {
+        sim.run_steps(steps.saturating_sub(1))?;
+        sim.request_energy();
+        sim.run_steps(steps.min(1))
+    })?;
+    let seconds = t.elapsed().as_secs_f64();
+    Ok(Timing { threads, steps, particles: sim.particles.len(), seconds, rebuilds: sim.rebuild_count() - r0 })
+}
+
 /// Writes the particles as a LAMMPS data file (`atom_style sphere`, SI units): `Atoms` lines
 /// `id type diameter density x y z`, and `Velocities` lines `id vx vy vz wx wy wz`.
 pub fn write_lammps_data<L: crate::contact::ContactLaw>(
@@ -302,12 +403,70 @@ pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
         "  memory: {:.0} bytes per particle between steps (particles, pair list with histories, wall candidates)",
         sim.bytes_per_particle()
     ));
+    // The clumps start on a loose lattice six layers high: the bed needs about 0.15 s (30 000 steps)
+    // to come to rest, whatever the footprint.
+    lines.extend(bench_clumps(&case, CLUMP_SETTLE_STEPS, steps, one.rate(), two.rate())?);
+    Ok(lines)
+}
+
+/// The clump case next to the sphere rates `sphere_one`, `sphere_two` (particle-steps/s on 1 and 2
+/// threads): member-sphere-steps/s and the cost per member relative to a free sphere.
+pub fn bench_clumps(
+    case: &BoxCase,
+    settle_steps: u64,
+    steps: u64,
+    sphere_one: f64,
+    sphere_two: f64,
+) -> Result<Vec<String>, DemError> {
+    let mut lines = Vec::new();
+    let t = Instant::now();
+    let (mut sim, l) = clump_box(case);
+    settle(&mut sim, settle_steps)?;
+    let state = sim.state();
+    lines.push(format!(
+        "dem bench, clumps: {} member spheres in {} tetrahedral 4-sphere clumps (box {:.0} x {:.0} mm), settled {} \
+         steps in {:.1} s; contacts {} member-member, {} member-wall",
+        sim.particles.len(),
+        sim.bodies().len(),
+        l.x * 1e3,
+        l.y * 1e3,
+        settle_steps,
+        t.elapsed().as_secs_f64(),
+        sim.last_evaluation().pair_contacts,
+        sim.last_evaluation().wall_contacts
+    ));
+    let one = time_clump_run(case, &state, 1, steps)?;
+    let two = time_clump_run(case, &state, 2, steps)?;
+    lines.push(format!(
+        "  1 thread : {:.3e} member-sphere-steps/s, {:.2}x the cost of a free sphere ({} rebuilds)",
+        one.rate(),
+        sphere_one / one.rate(),
+        one.rebuilds
+    ));
+    lines.push(format!(
+        "  2 threads: {:.3e} member-sphere-steps/s, {:.2}x the cost of a free sphere; speed-up {:.2}",
+        two.rate(),
+        sphere_two / two.rate(),
+        two.rate() / one.rate()
+    ));
     Ok(lines)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clump_box_has_the_member_count_of_the_sphere_box_and_no_overlaps() {
+        let case = BoxCase { cells: [4, 4, 3], ..BoxCase::full() };
+        let (mut sim, _) = clump_box(&case);
+        assert_eq!(sim.particles.len(), case.count());
+        sim.run_steps(1).unwrap();
+        assert_eq!(sim.last_evaluation().pair_contacts, 0, "clumps start apart");
+        settle(&mut sim, 4000).unwrap();
+        let e = *sim.last_evaluation();
+        assert!(e.pair_contacts > 0 && e.wall_contacts > 0, "{e:?}");
+    }
 
     #[test]
     fn box_case_builds_without_overlaps_and_settles_in_contact() {

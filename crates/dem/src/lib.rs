@@ -4,6 +4,7 @@ pub mod adhesion;
 pub mod restitution_models;
 
 pub mod bench;
+pub mod clump;
 pub mod contact;
 pub mod error;
 pub mod insertion;
@@ -14,6 +15,7 @@ pub mod sim;
 pub mod timestep;
 pub mod validation;
 pub mod walls;
+pub mod wear;
 
 pub use error::DemError;
 pub use particles::{NewParticle, Particles};

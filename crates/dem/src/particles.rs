@@ -7,6 +7,7 @@
 //! (`inv_mass = 0`): they are never integrated, keep the velocity they were given, and a
 //! contact with one behaves like a contact with a rigid body (m* = m of the free partner).
 
+use crate::clump::NO_BODY;
 use serde::{Deserialize, Serialize};
 use spatter_core::math::sphere_volume;
 use spatter_core::Vec3;
@@ -37,6 +38,10 @@ pub struct Particles {
     pub ext_force: Vec<Vec3>,
     /// Persistent external torque per particle \[N m\]; empty until first used.
     pub ext_torque: Vec<Vec3>,
+    /// Index of the rigid body the sphere belongs to ([`NO_BODY`] for a free sphere); empty while the
+    /// simulation has no bodies (see [`crate::clump`]).
+    #[serde(default)]
+    pub body: Vec<u32>,
     next_id: u32,
 }
 
@@ -97,7 +102,27 @@ impl Particles {
             self.ext_force.push(Vec3::ZERO);
             self.ext_torque.push(Vec3::ZERO);
         }
+        if !self.body.is_empty() {
+            self.body.push(NO_BODY);
+        }
         id
+    }
+
+    /// Appends a member sphere of body `body` that carries the body's inverse mass `inv_mass` \[1/kg\]
+    /// (the mass its contacts see); returns its id.
+    pub(crate) fn push_member(&mut self, p: NewParticle, inv_mass: f64, body: u32) -> u32 {
+        let id = self.push(NewParticle { frozen: false, ..p }, 1.0);
+        self.body.resize(self.len(), NO_BODY);
+        let i = self.len() - 1;
+        self.inv_mass[i] = inv_mass;
+        self.body[i] = body;
+        id
+    }
+
+    /// Whether particle `i` (index) is a member of a rigid body.
+    #[inline]
+    pub fn is_member(&self, i: usize) -> bool {
+        !self.body.is_empty() && self.body[i] != NO_BODY
     }
 
     /// Whether particle `i` (index) is frozen.
@@ -166,6 +191,7 @@ impl Particles {
         apply(&mut self.ext_torque, perm, &mut s.vecs);
         apply(&mut self.radius, perm, &mut s.f64s);
         apply(&mut self.inv_mass, perm, &mut s.f64s);
+        apply(&mut self.body, perm, &mut s.u32s);
     }
 
     /// Removes the particles for which `remove(index)` is true (order of the rest is kept).
@@ -193,12 +219,14 @@ impl Particles {
         filter(&mut self.ext_torque, &mask);
         filter(&mut self.radius, &mask);
         filter(&mut self.inv_mass, &mask);
+        filter(&mut self.body, &mask);
     }
 
     /// Bytes of particle state per particle (for memory reports).
     pub fn bytes_per_particle(&self) -> usize {
         let ext = if self.ext_force.is_empty() { 0 } else { 48 };
-        4 + 2 + 5 * 24 + 2 * 8 + ext
+        let body = if self.body.is_empty() { 0 } else { 4 };
+        4 + 2 + 5 * 24 + 2 * 8 + ext + body
     }
 }
 

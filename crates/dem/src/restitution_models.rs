@@ -25,7 +25,7 @@
 //! and is the default.
 //!
 //! The impact speed V that sets e is the normal impact speed of the run (the thesis computed e per run
-//! and passed it to LIGGGHTS as a constant coefficient of restitution, digest §2.5).
+//! and passed it to LIGGGHTS as a constant coefficient of restitution).
 
 use crate::contact::restitution_fit::DampingTable;
 use crate::contact::RestitutionCalibration;
@@ -341,7 +341,7 @@ impl crate::contact::DampingLaw for SpeedDependentDamping {
 mod tests {
     use super::*;
 
-    const E_ICE_ABS: f64 = 1.88329e9; // digest §3.5
+    const E_ICE_ABS: f64 = 1.88329e9; // from Lind (2017) Table 2
 
     fn rel(a: f64, b: f64) -> f64 {
         ((a - b) / b).abs()
@@ -349,9 +349,9 @@ mod tests {
 
     #[test]
     fn thesis_constants() {
-        // Digest §4.1 V4: 1.185 · 1.56^{1/4} = 1.3243 (thesis Eq. 34 prints 1.324);
+        // Lind (2017): 1.185 · 1.56^{1/4} = 1.3243 (thesis Eq. 34 prints 1.324);
         // V5: 3.194/√(4π/3) = 1.5607 (thesis Eq. 31 ↔ Eq. 32 prints 1.56). Tolerance 1e-4 relative: the
-        // exact value is 1.56060, which the digest rounds to 1.5607.
+        // exact value is 1.56060, which rounds to 1.5607.
         assert!(rel(1.185 * 1.56f64.powf(0.25), 1.3243) < 1e-4);
         assert!(rel(3.194 / (4.0 * std::f64::consts::PI / 3.0).sqrt(), 1.5607) < 1e-4);
         // Thornton's full formula tends to 1.185 (V_y/V)^{1/4}: √(6√3/5)/(2√(6/5))^{1/4} = 1.18499.
@@ -366,9 +366,9 @@ mod tests {
     }
 
     #[test]
-    fn digest_cor_table() {
-        // digests/seed_000_snow_dem.md §3.5: V_y and e = c V^{-1/4} of Eq. 34 for σ_y = 0.5, 1, 1.5 MPa
-        // (ice–ABS E*, ρ = 920). The digest uses the exact Eq. 34 constant 1.324, so compare the power law
+    fn thornton_cor_table() {
+        // Lind (2017): V_y and e = c V^{-1/4} of Eq. 34 for σ_y = 0.5, 1, 1.5 MPa
+        // (ice–ABS E*, ρ = 920). The table uses the printed Eq. 34 constant 1.324, so compare the power law
         // (1.185·1.56^{1/4} = 1.32436) to 5e-4 relative.
         let rows = [
             (0.5e6, 2.533e-5, 0.08405, [0.2658, 0.1495, 0.0840, 0.0473]),
@@ -465,7 +465,7 @@ mod tests {
         // restitution equals the closed-form e(V); explicit Verlet at 2000 steps per contact: tolerance
         // 2e-3 absolute. References computed independently of this module (σ_y = 1 MPa, p_y = 2.5 MPa):
         // * ice sphere R = 10 µm on ABS (E* = 1.88329e9 Pa, ρ = 920): V_y = 1.56√(p_y⁵/(E*⁴ρ)) =
-        //   1.43300e-4 m/s (digest §3.5: 1.433e-4); e(0.5) = 0.154177, e(5) = 0.086703;
+        //   1.43300e-4 m/s (1.433e-4 from Lind 2017 Table 2 inputs); e(0.5) = 0.154177, e(5) = 0.086703;
         // * two ice spheres R = 10 µm (E* = 5.42095e9 Pa, R* = 5 µm, m* = m/2): Eq. 31 gives V_y =
         //   8.65098e-6 m/s, e(0.5) = 0.076426, e(5) = 0.042977; the thesis's wall formula with ρ = 920 gives
         //   V_y = 1.72953e-5 m/s (twice Eq. 31), e(0.5) = 0.090877, e(5) = 0.051104.

@@ -141,12 +141,12 @@ fn closed_forms(_quick: bool) -> Vec<Check> {
     out
 }
 
-/// Digest §6.1 items 7 and 8: the pull-off inverse check (measured pull-off forces → σ with the JKR form
+/// Jasion (2013) chapter 6: the pull-off inverse check (measured pull-off forces → σ with the JKR form
 /// (3/2)πσr, Jasion eq. 3.54, L1253) and the damping ratio of the restitution-to-damping map (eq. 3.64).
 fn pull_off_and_damping(d61: &str) -> Vec<Check> {
     use crate::forces::contact::*;
     let case = "flow_closed_forms";
-    // The digest quotes σ to 3 significant figures: half a unit in the third digit (as for Table 6.4).
+    // The thesis quotes σ to 3 significant figures: half a unit in the third digit (as for Table 6.4).
     let half_unit = |v: f64| 0.5 * 10f64.powf(v.abs().log10().floor() - 2.0) / v.abs() * (1.0 + 1e-9);
     let src = format!("{d61} item 7 (Jasion L1253, JKR pull-off (3/2)πσr inverted)");
     let mut out = Vec::new();
@@ -185,7 +185,7 @@ fn pull_off_and_damping(d61: &str) -> Vec<Check> {
         1e-12,
         format!("{d61} item 7 (Jasion eq. 3.54–3.55)"),
     ));
-    // ξ(e) = −ln e/√(π² + ln²e): the digest quotes 4 decimals; half a unit in the 4th (5e-5 absolute).
+    // ξ(e) = −ln e/√(π² + ln²e), quoted to 4 decimals; half a unit in the 4th (5e-5 absolute).
     let src = format!("{d61} item 8 (Jasion eq. 3.64, ξ = −ln e/√(π² + ln²e))");
     out.push(Check::absolute(
         case,
@@ -196,7 +196,7 @@ fn pull_off_and_damping(d61: &str) -> Vec<Check> {
         src.clone(),
     ));
     out.push(Check::absolute(case, "damping ratio ξ(e = 1e-4) [-]", 0.9465, damping_ratio(1e-4), 5e-5, src));
-    // The linear contact with c from eq. 3.64 rebounds with the e it was built for (digest: e = 0.5).
+    // The linear contact with c from eq. 3.64 rebounds with the e it was built for (e = 0.5).
     let (k, m) = (1.0, 1.0);
     out.push(Check::relative(
         case,
@@ -233,7 +233,7 @@ fn single(
 fn terminal_velocity(_quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     let fluid = Fluid { density: 1.19, viscosity: 1.82e-5 };
-    // Stokes regime: 10 µm sand, v_t = (ρ_p − ρ_f) g d²/(18μ) (7.43 mm/s for r_p = 5 µm: digest §6.1 item 10).
+    // Stokes regime: 10 µm sand, v_t = (ρ_p − ρ_f) g d²/(18μ) (7.43 mm/s for r_p = 5 µm).
     let (d, rho) = (10e-6, 2480.0);
     let tau = stokes_time(&fluid, d, rho);
     let sw = ForceSwitches { drag: DragLaw::Stokes, ..Default::default() };
@@ -248,7 +248,7 @@ fn terminal_velocity(_quick: bool) -> Vec<Check> {
         let _ = tr.step();
     }
     // Consistency check of the integrator: the exponential update is exact for constant forces, so it
-    // must land on Stokes' law to rounding (7.43 mm/s agrees with the digest's value, §6.1 item 10).
+    // must land on Stokes' law to rounding (7.43 mm/s).
     let analytic = (rho - fluid.density) * 9.81 * d * d / (18.0 * fluid.viscosity);
     out.push(Check::relative(
         "flow_terminal_velocity",

@@ -3,6 +3,7 @@
 //! * [`run`] — the run folder, the context a job runs in and the summary it returns;
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
 //! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
+//! * [`vtr`] — VTK XML rectilinear grids (structured flow fields);
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
 //! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
 //! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
@@ -18,6 +19,8 @@ pub mod report;
 pub mod run;
 pub mod runlog;
 pub mod summary;
+mod vtk_xml;
+pub mod vtr;
 pub mod vtu;
 
 /// Formats `x` so that it parses back to the same `f64` (shortest round-trip form), in exponent notation

@@ -1,4 +1,5 @@
-//! Pictures: line/marker charts (PNG or SVG) and colour maps of values on triangle meshes.
+//! Pictures: line/marker charts (PNG or SVG), colour maps of values on triangle meshes and of cell
+//! fields on 2D rectilinear grids.
 //!
 //! Text is drawn with DejaVu Sans embedded in the binary (`assets/fonts`), so pictures render the same on
 //! every machine without system fonts.
@@ -327,6 +328,140 @@ pub fn viridis(t: f64) -> (u8, u8, u8) {
     (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// Draws a vertical viridis colour bar `x0..x0 + 25` px wide between `top` and `bottom` px, with five
+/// labelled ticks from `range.0` to `range.1` and `label` wrapped above it starting at `label_x`.
+fn colour_bar<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    x0: i32,
+    (top, bottom): (i32, i32),
+    (vmin, vmax): (f64, f64),
+    label: &str,
+    label_x: i32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let x1 = x0 + 25;
+    let steps = 100;
+    let y_at = |f: f64| bottom - ((bottom - top) as f64 * f).round() as i32;
+    for k in 0..steps {
+        let t0 = k as f64 / steps as f64;
+        let (y_hi, y_lo) = (y_at((k + 1) as f64 / steps as f64), y_at(t0));
+        let (r, g, b) = viridis(t0);
+        root.draw(&Rectangle::new([(x0, y_hi), (x1, y_lo)], RGBColor(r, g, b).filled()))?;
+    }
+    root.draw(&Rectangle::new([(x0, top), (x1, bottom)], BLACK.stroke_width(1)))?;
+    for k in 0..=4 {
+        let f = k as f64 / 4.0;
+        let y = y_at(f);
+        root.draw(&PathElement::new(vec![(x1, y), (x1 + 4, y)], BLACK.stroke_width(1)))?;
+        let text = tick_label(vmin + f * (vmax - vmin));
+        root.draw(&Text::new(text, (x1 + 7, y - 7), ("sans-serif", 13)))?;
+    }
+    // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
+    let lines = wrap_words(label, 20);
+    let first = top - 12 - 16 * lines.len() as i32;
+    for (k, line) in lines.iter().enumerate() {
+        root.draw(&Text::new(line.clone(), (label_x, first + 16 * k as i32), ("sans-serif", 14)))?;
+    }
+    Ok(())
+}
+
+/// A scalar field on the cells of a 2D rectilinear grid, for [`field_map_png`].
+#[derive(Clone, Copy, Debug)]
+pub struct FieldMap<'a> {
+    /// Face coordinates along the horizontal and vertical axes (strictly increasing).
+    pub x_faces: &'a [f64],
+    pub y_faces: &'a [f64],
+    /// One value per cell, x fastest: cell (i, j) is `values[i + nx·j]`. NaN marks cells without data
+    /// (solids), drawn grey.
+    pub values: &'a [f64],
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub colorbar_label: &'a str,
+}
+
+/// Renders a [`FieldMap`] to scale (equal lengths on both axes; a side shorter than 300 px is stretched
+/// to 300 px) with axes, ticks, a title across the picture and a viridis colour bar spanning the finite
+/// values.
+pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
+    let (nx, ny) = (map.x_faces.len().saturating_sub(1), map.y_faces.len().saturating_sub(1));
+    if nx == 0 || ny == 0 || map.values.len() != nx * ny {
+        return Err(err(path, format!("{} values for a {nx} × {ny} grid", map.values.len())));
+    }
+    ensure_font();
+    let (x0, x1) = (map.x_faces[0], map.x_faces[nx]);
+    let (y0, y1) = (map.y_faces[0], map.y_faces[ny]);
+    if !(x1 > x0 && y1 > y0) {
+        return Err(err(path, "face coordinates must increase"));
+    }
+    let finite = map.values.iter().copied().filter(|v| v.is_finite());
+    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
+    let vmin = finite.fold(f64::INFINITY, f64::min);
+    let (vmin, vmax) = if !vmax.is_finite() {
+        (0.0, 1.0)
+    } else if vmax > vmin {
+        (vmin, vmax)
+    } else {
+        (vmin - 0.5, vmin + 0.5)
+    };
+    // Plot area to scale within 760 × 640 px; a side that would be shorter than 300 px is stretched to
+    // 300 px (long thin domains such as pipes), which the axis ticks make plain.
+    let scale = (760.0 / (x1 - x0)).min(640.0 / (y1 - y0));
+    let pw = ((x1 - x0) * scale).round().max(300.0) as u32;
+    let ph = ((y1 - y0) * scale).round().max(300.0) as u32;
+    let (left_axis, bottom_axis, margin, caption) = (78u32, 48u32, 14u32, 40u32);
+    let chart_w = pw + left_axis + 2 * margin;
+    let h = (ph + bottom_axis + 2 * margin + caption).max(600);
+    // The title spans the whole picture; it sets the smallest width (about 11 px per character).
+    let w = (chart_w + 170).max(40 + 11 * map.title.chars().count() as u32);
+    let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| err(path, x))?;
+    let e = |x: DrawingAreaErrorKind<_>| err(path, x);
+    let body = root.titled(map.title, ("sans-serif", 22)).map_err(e)?;
+    let (left, right) = body.split_horizontally(chart_w);
+    let mut chart = ChartBuilder::on(&left)
+        .margin(margin)
+        .x_label_area_size(bottom_axis)
+        .y_label_area_size(left_axis)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    let (xs, ys) = (x1 - x0, y1 - y0);
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(map.x_label)
+        .y_desc(map.y_label)
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&|v| axis_tick_label(*v, xs))
+        .y_label_formatter(&|v| axis_tick_label(*v, ys))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(e)?;
+    let shade = |v: f64| -> RGBColor {
+        if v.is_finite() {
+            let (r, g, b) = viridis((v - vmin) / (vmax - vmin));
+            RGBColor(r, g, b)
+        } else {
+            RGBColor(200, 200, 200)
+        }
+    };
+    chart
+        .draw_series((0..ny).flat_map(|j| {
+            (0..nx).map(move |i| {
+                Rectangle::new(
+                    [(map.x_faces[i], map.y_faces[j]), (map.x_faces[i + 1], map.y_faces[j + 1])],
+                    shade(map.values[i + nx * j]).filled(),
+                )
+            })
+        }))
+        .map_err(e)?;
+    let top = 60;
+    let bottom = (h as i32 - 110).min(top + 440);
+    colour_bar(&right, 30, (top, bottom), (vmin, vmax), map.colorbar_label, 15).map_err(e)?;
+    root.present().map_err(e)
+}
+
 /// A coordinate axis as seen on a picture (see [`axis_triad`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScreenAxis {
@@ -374,23 +509,36 @@ pub fn mesh_map_png(
     title: &str,
     colorbar_label: &str,
 ) -> io::Result<()> {
-    mesh_map_png_range(path, mesh, values, None, view_dir, up, title, colorbar_label)
+    mesh_map_png_on_scale(path, mesh, values, (view_dir, up), (title, colorbar_label), auto_scale(values))
 }
 
-/// Like [`mesh_map_png`], on the colour scale `range` = `[low, high]` when given (values beyond it take
-/// the end colours, so maps of several runs compare on one scale), else from min(0, smallest value) to
-/// the largest value.
-#[allow(clippy::too_many_arguments)]
-pub fn mesh_map_png_range(
+/// The colour scale [`mesh_map_png`] chooses for `values`: from 0 (or the minimum, if negative) to the
+/// largest finite value; `(0, 1)` when there is nothing to scale.
+pub fn auto_scale(values: &[f64]) -> (f64, f64) {
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
+    let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
+    if vmax.is_finite() && vmax > vmin {
+        (vmin, vmax)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// [`mesh_map_png`] on a given colour scale `(low, high)` (values outside it take the end colours), so
+/// that maps of several runs can be compared colour for colour; `view` is (view direction, up) and
+/// `labels` (title, colour-bar label).
+pub fn mesh_map_png_on_scale(
     path: &Path,
     mesh: &TriMesh,
     values: &[f64],
-    range: Option<[f64; 2]>,
-    view_dir: Vec3,
-    up: Vec3,
-    title: &str,
-    colorbar_label: &str,
+    (view_dir, up): (Vec3, Vec3),
+    (title, colorbar_label): (&str, &str),
+    (vmin, vmax): (f64, f64),
 ) -> io::Result<()> {
+    if !(vmin.is_finite() && vmax.is_finite() && vmax > vmin) {
+        return Err(err(path, format!("colour scale {vmin}..{vmax} must be finite and increasing")));
+    }
     if values.len() != mesh.triangles.len() {
         return Err(err(path, format!("{} values for {} triangles", values.len(), mesh.triangles.len())));
     }
@@ -414,15 +562,6 @@ pub fn mesh_map_png_range(
     if !x0.is_finite() {
         return Err(err(path, "mesh has no vertices"));
     }
-    let finite = values.iter().copied().filter(|v| v.is_finite());
-    let vmax = finite.clone().fold(f64::NEG_INFINITY, f64::max);
-    let vmin = finite.fold(f64::INFINITY, f64::min).min(0.0);
-    let (vmin, vmax) = match range {
-        Some([lo, hi]) if hi > lo => (lo, hi),
-        _ if vmax.is_finite() && vmax > vmin => (vmin, vmax),
-        _ => (0.0, 1.0),
-    };
-
     // Painter's algorithm: far triangles first.
     let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
     let depth: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.centroid(t).dot(d)).collect();
@@ -450,7 +589,7 @@ pub fn mesh_map_png_range(
         .map_err(|x| err(path, x))?;
     let shade = |v: f64| -> RGBColor {
         if v.is_finite() {
-            let (r, g, b) = viridis(((v - vmin) / (vmax - vmin)).clamp(0.0, 1.0));
+            let (r, g, b) = viridis((v - vmin) / (vmax - vmin));
             RGBColor(r, g, b)
         } else {
             RGBColor(200, 200, 200)
@@ -464,35 +603,7 @@ pub fn mesh_map_png_range(
     root.draw(&Text::new(view_caption(view_dir, up), (mx0 as i32, 734), ("sans-serif", 14)))
         .map_err(|x| err(path, x))?;
 
-    // Colour bar with labelled ticks.
-    let (bar_x0, bar_x1) = (870i32, 895i32);
-    let (bar_top, bar_bottom) = (80i32, 520i32);
-    let steps = 100;
-    let y_at = |f: f64| bar_bottom - ((bar_bottom - bar_top) as f64 * f).round() as i32;
-    for k in 0..steps {
-        let t0 = k as f64 / steps as f64;
-        let (y_hi, y_lo) = (y_at((k + 1) as f64 / steps as f64), y_at(t0));
-        let (r, g, b) = viridis(t0);
-        root.draw(&Rectangle::new([(bar_x0, y_hi), (bar_x1, y_lo)], RGBColor(r, g, b).filled()))
-            .map_err(|x| err(path, x))?;
-    }
-    root.draw(&Rectangle::new([(bar_x0, bar_top), (bar_x1, bar_bottom)], BLACK.stroke_width(1)))
-        .map_err(|x| err(path, x))?;
-    for k in 0..=4 {
-        let f = k as f64 / 4.0;
-        let y = y_at(f);
-        root.draw(&PathElement::new(vec![(bar_x1, y), (bar_x1 + 4, y)], BLACK.stroke_width(1)))
-            .map_err(|x| err(path, x))?;
-        let label = tick_label(vmin + f * (vmax - vmin));
-        root.draw(&Text::new(label, (bar_x1 + 7, y - 7), ("sans-serif", 13))).map_err(|x| err(path, x))?;
-    }
-    // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
-    let lines = wrap_words(colorbar_label, 20);
-    let first = bar_top - 12 - 16 * lines.len() as i32;
-    for (k, line) in lines.iter().enumerate() {
-        root.draw(&Text::new(line.clone(), (855, first + 16 * k as i32), ("sans-serif", 14)))
-            .map_err(|x| err(path, x))?;
-    }
+    colour_bar(&root, 870, (80, 520), (vmin, vmax), colorbar_label, 855).map_err(|x| err(path, x))?;
 
     // Axis triad: arrows of length `len` from the origin `o`, far axes first so near ones stay on top.
     let o = (925.0, 640.0);
@@ -568,6 +679,35 @@ mod tests {
         assert_eq!(png_size(&dir.path().join("a.png")), (900, 650));
         let svg = std::fs::read_to_string(dir.path().join("a.svg")).unwrap();
         assert!(svg.contains("power law"));
+    }
+
+    #[test]
+    fn field_map_is_drawn_to_scale_and_checks_lengths() {
+        let dir = tempfile::tempdir().unwrap();
+        let xf = [0.0, 1.0, 2.0, 4.0];
+        let yf = [0.0, 0.5, 1.0];
+        let map = FieldMap {
+            x_faces: &xf,
+            y_faces: &yf,
+            values: &[1.0, 2.0, f64::NAN, 0.0, -1.0, 3.0],
+            title: "t",
+            x_label: "x [m]",
+            y_label: "y [m]",
+            colorbar_label: "v",
+        };
+        let p = dir.path().join("f.png");
+        field_map_png(&p, &map).unwrap();
+        // 4 m × 1 m: 760 × 190 px plot (stretched to 300 px high), plus axes, margins and the colour bar.
+        assert_eq!(png_size(&p), (760 + 78 + 28 + 170, 600));
+        // A long title widens the picture instead of being cut.
+        let long = "a title much longer than the plot is wide, as a pipe picture has it: speed on the cut";
+        let thin_x = [0.0, 0.05];
+        let thin_y = [0.0, 2.5, 5.0];
+        let thin = FieldMap { x_faces: &thin_x, y_faces: &thin_y, values: &[1.0, 2.0], title: long, ..map };
+        field_map_png(&p, &thin).unwrap();
+        assert_eq!(png_size(&p).0, 40 + 11 * long.chars().count() as u32);
+        let short = FieldMap { values: &[1.0; 5], ..map };
+        assert!(field_map_png(&p, &short).unwrap_err().to_string().contains("5 values for a 3 × 2 grid"));
     }
 
     #[test]
@@ -662,6 +802,28 @@ mod picture_check {
             "kg/m²",
         )
         .unwrap();
+        let xf: Vec<f64> = (0..=40).map(|i| 2.0 * (i as f64 / 40.0).powf(1.3)).collect();
+        let yf: Vec<f64> = (0..=20).map(|j| j as f64 / 20.0).collect();
+        let vals: Vec<f64> = (0..800)
+            .map(|c| {
+                let (x, y) = (xf[c % 40], yf[c / 40]);
+                if (x - 0.5).hypot(y - 0.5) < 0.2 {
+                    f64::NAN
+                } else {
+                    (3.0 * x).sin() * y
+                }
+            })
+            .collect();
+        let map = FieldMap {
+            x_faces: &xf,
+            y_faces: &yf,
+            values: &vals,
+            title: "field",
+            x_label: "x [m]",
+            y_label: "y [m]",
+            colorbar_label: "velocity magnitude [m/s]",
+        };
+        field_map_png(&dir.join("field.png"), &map).unwrap();
     }
 }
 

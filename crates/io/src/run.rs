@@ -4,7 +4,7 @@
 //! snapshots, pictures, and `checkpoint.bin` while it is unfinished.
 
 use crate::checkpoint::CheckpointError;
-use serde::{de::DeserializeOwned, Serialize};
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
 use spatter_core::control::{Finished, RunControl};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -100,11 +100,39 @@ pub struct RunSummary {
     /// Named scalar results (name carries the unit, e.g. `stick_fraction`, `total_J`): the columns a study's
     /// results table gets for this run, one row per case.
     pub scalars: Vec<(String, f64)>,
+    /// Colour maps on triangle meshes the run drew, with what it takes to draw them again: a study redraws
+    /// the same map of every case on one colour scale.
+    pub maps: Vec<MeshMapRecord>,
+}
+
+/// A per-triangle colour map a run drew with [`crate::plot::mesh_map_png`] from a cell array of a triangle
+/// `.vtu` it wrote.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshMapRecord {
+    /// Names the map; the same map of two runs of a study has the same label (e.g. `panel deposit`).
+    pub label: String,
+    /// The triangle `.vtu` holding the values (relative to the run folder in `summary.json`).
+    pub vtu: PathBuf,
+    /// The cell array drawn.
+    pub array: String,
+    /// Direction the mesh is seen along and the up vector of the picture.
+    pub view_dir: [f64; 3],
+    pub up: [f64; 3],
+    /// Title and colour-bar label of the picture.
+    pub title: String,
+    pub colorbar_label: String,
 }
 
 impl RunSummary {
     pub fn new(finished: Finished) -> Self {
-        RunSummary { finished, headline: Vec::new(), artifacts: Vec::new(), scalars: Vec::new() }
+        RunSummary {
+            finished,
+            headline: Vec::new(),
+            artifacts: Vec::new(),
+            scalars: Vec::new(),
+            maps: Vec::new(),
+        }
     }
 
     /// Records the scalar result `name` (unit in the name) for study tables.

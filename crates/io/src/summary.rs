@@ -2,7 +2,7 @@
 //! runner uses it to skip finished cases and to build its results table, the run report to show the key
 //! numbers.
 
-use crate::run::RunSummary;
+use crate::run::{MeshMapRecord, RunSummary};
 use serde::{Deserialize, Serialize};
 use spatter_core::control::Finished;
 use std::path::{Path, PathBuf};
@@ -31,6 +31,10 @@ pub struct SummaryFile {
     /// The warnings among the closing lines.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// Colour maps on triangle meshes, with the `.vtu` paths relative to the run folder where they are
+    /// inside it.
+    #[serde(default)]
+    pub maps: Vec<MeshMapRecord>,
 }
 
 impl SummaryFile {
@@ -55,6 +59,14 @@ impl SummaryFile {
             wall_time_s,
             threads,
             warnings: s.headline.iter().filter(|l| l.starts_with("warning")).cloned().collect(),
+            maps: s
+                .maps
+                .iter()
+                .map(|m| MeshMapRecord {
+                    vtu: m.vtu.strip_prefix(root).map(Path::to_owned).unwrap_or_else(|_| m.vtu.clone()),
+                    ..m.clone()
+                })
+                .collect(),
         }
     }
 
@@ -102,6 +114,15 @@ mod tests {
         s.scalar("z_m", 0.1);
         s.scalar("a_J", f64::NAN);
         s.artifacts.push(("map".into(), dir.path().join("map.png")));
+        s.maps.push(MeshMapRecord {
+            label: "panel".into(),
+            vtu: dir.path().join("panel.vtu"),
+            array: "impacts".into(),
+            view_dir: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            title: "panel: impacts".into(),
+            colorbar_label: "impacts".into(),
+        });
         let f = SummaryFile::of(&s, "dem", dir.path(), 1.5, 2);
         f.write(dir.path()).unwrap();
         let back = SummaryFile::read(dir.path()).unwrap().unwrap();
@@ -109,6 +130,7 @@ mod tests {
         assert_eq!(back.scalars[0].0, "z_m");
         assert!(back.scalar("a_J").unwrap().is_nan());
         assert_eq!(back.artifacts[0].1, Path::new("map.png"));
+        assert_eq!(back.maps[0].vtu, Path::new("panel.vtu"));
         assert!(back.completed());
         std::fs::write(dir.path().join(FILE), "{").unwrap();
         assert!(SummaryFile::read(dir.path()).unwrap_err().contains("not a run summary"));

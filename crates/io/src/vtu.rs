@@ -1,10 +1,9 @@
 //! VTK XML unstructured grids (`.vtu`) for particles (one vertex cell per particle) and triangle meshes,
 //! with point and cell data, as ParaView reads them; and a strict reader for the files written here.
 //!
-//! Arrays are stored inline in VTK's `binary` format: base64 of a `UInt64` byte count followed by the
-//! little-endian values, one base64 stream per array (`header_type="UInt64"`, no compression).
+//! Arrays are stored inline in VTK's `binary` format ([`crate::vtk_xml`]).
 
-use base64::Engine;
+use crate::vtk_xml::{bad, decode, push, write_array, write_section, write_u8_array, Array, Values};
 use quick_xml::events::Event;
 use spatter_core::Vec3;
 use std::collections::BTreeMap;
@@ -14,19 +13,6 @@ use std::path::Path;
 
 const VTK_VERTEX: u8 = 1;
 const VTK_TRIANGLE: u8 = 5;
-
-#[derive(Clone, Debug, PartialEq)]
-enum Values {
-    F64(Vec<f64>),
-    I64(Vec<i64>),
-}
-
-#[derive(Clone, Debug, PartialEq)]
-struct Array {
-    name: String,
-    components: usize,
-    values: Values,
-}
 
 /// Builder for one `.vtu` file.
 #[derive(Clone, Debug)]
@@ -77,49 +63,40 @@ impl Vtu {
         self.types.len()
     }
 
-    fn push(list: &mut Vec<Array>, expected: usize, name: &str, components: usize, values: Values) {
-        let len = match &values {
-            Values::F64(v) => v.len(),
-            Values::I64(v) => v.len(),
-        };
-        assert_eq!(len, expected * components, "VTU array `{name}`: {len} values for {expected} entities");
-        list.push(Array { name: name.to_owned(), components, values });
-    }
-
     /// Adds a scalar per point. Panics if the length differs from the number of points (a programming error).
     pub fn point_scalar(mut self, name: &str, v: &[f64]) -> Self {
         let n = self.n_points();
-        Self::push(&mut self.point_data, n, name, 1, Values::F64(v.to_vec()));
+        push(&mut self.point_data, n, name, 1, Values::F64(v.to_vec()));
         self
     }
 
     pub fn point_vector(mut self, name: &str, v: &[Vec3]) -> Self {
         let n = self.n_points();
-        Self::push(&mut self.point_data, n, name, 3, Values::F64(flatten(v)));
+        push(&mut self.point_data, n, name, 3, Values::F64(flatten(v)));
         self
     }
 
     pub fn point_int(mut self, name: &str, v: &[i64]) -> Self {
         let n = self.n_points();
-        Self::push(&mut self.point_data, n, name, 1, Values::I64(v.to_vec()));
+        push(&mut self.point_data, n, name, 1, Values::I64(v.to_vec()));
         self
     }
 
     pub fn cell_scalar(mut self, name: &str, v: &[f64]) -> Self {
         let n = self.n_cells();
-        Self::push(&mut self.cell_data, n, name, 1, Values::F64(v.to_vec()));
+        push(&mut self.cell_data, n, name, 1, Values::F64(v.to_vec()));
         self
     }
 
     pub fn cell_vector(mut self, name: &str, v: &[Vec3]) -> Self {
         let n = self.n_cells();
-        Self::push(&mut self.cell_data, n, name, 3, Values::F64(flatten(v)));
+        push(&mut self.cell_data, n, name, 3, Values::F64(flatten(v)));
         self
     }
 
     pub fn cell_int(mut self, name: &str, v: &[i64]) -> Self {
         let n = self.n_cells();
-        Self::push(&mut self.cell_data, n, name, 1, Values::I64(v.to_vec()));
+        push(&mut self.cell_data, n, name, 1, Values::I64(v.to_vec()));
         self
     }
 
@@ -137,13 +114,8 @@ impl Vtu {
             self.n_points(),
             self.n_cells()
         );
-        for (tag, list) in [("PointData", &self.point_data), ("CellData", &self.cell_data)] {
-            let _ = writeln!(s, "      <{tag}>");
-            for a in list {
-                write_array(&mut s, &a.name, a.components, &a.values);
-            }
-            let _ = writeln!(s, "      </{tag}>");
-        }
+        write_section(&mut s, "PointData", &self.point_data);
+        write_section(&mut s, "CellData", &self.cell_data);
         s.push_str("      <Points>\n");
         write_array(&mut s, "Points", 3, &Values::F64(self.points.clone()));
         s.push_str("      </Points>\n      <Cells>\n");
@@ -161,38 +133,6 @@ impl Vtu {
     }
 }
 
-fn encode(bytes: &[u8]) -> String {
-    let mut raw = Vec::with_capacity(8 + bytes.len());
-    raw.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
-    raw.extend_from_slice(bytes);
-    base64::engine::general_purpose::STANDARD.encode(raw)
-}
-
-fn write_array(s: &mut String, name: &str, components: usize, values: &Values) {
-    let (ty, bytes): (&str, Vec<u8>) = match values {
-        Values::F64(v) => ("Float64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        Values::I64(v) => ("Int64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-    };
-    let _ = writeln!(
-        s,
-        "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{components}\" format=\"binary\">{}</DataArray>",
-        xml_escape(name),
-        encode(&bytes)
-    );
-}
-
-fn write_u8_array(s: &mut String, name: &str, values: &[u8]) {
-    let _ = writeln!(
-        s,
-        "        <DataArray type=\"UInt8\" Name=\"{name}\" NumberOfComponents=\"1\" format=\"binary\">{}</DataArray>",
-        encode(values)
-    );
-}
-
-fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
 /// Contents of a `.vtu` file read back by [`read`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct VtuData {
@@ -203,10 +143,6 @@ pub struct VtuData {
     /// Name → (components, values as f64).
     pub point_data: BTreeMap<String, (usize, Vec<f64>)>,
     pub cell_data: BTreeMap<String, (usize, Vec<f64>)>,
-}
-
-fn bad(path: &Path, msg: impl std::fmt::Display) -> io::Error {
-    io::Error::new(io::ErrorKind::InvalidData, format!("{}: {msg}", path.display()))
 }
 
 /// Reads a `.vtu` written in the inline binary form used by [`Vtu::write`], checking the XML is well formed
@@ -260,46 +196,7 @@ pub fn read(path: &Path) -> io::Result<VtuData> {
             }
             Event::Text(t) => {
                 if let Some((ty, name, comps, format)) = current.take() {
-                    if format != "binary" {
-                        return Err(bad(
-                            path,
-                            format!("array `{name}` has format `{format}`; expected binary"),
-                        ));
-                    }
-                    let raw = base64::engine::general_purpose::STANDARD
-                        .decode(
-                            t.as_ref()
-                                .iter()
-                                .copied()
-                                .filter(|b| !b.is_ascii_whitespace())
-                                .collect::<Vec<u8>>(),
-                        )
-                        .map_err(|e| bad(path, format!("array `{name}`: bad base64: {e}")))?;
-                    if raw.len() < 8 {
-                        return Err(bad(path, format!("array `{name}` has no header")));
-                    }
-                    let len = u64::from_le_bytes(raw[..8].try_into().unwrap_or([0; 8])) as usize;
-                    let body = &raw[8..];
-                    if body.len() != len {
-                        return Err(bad(
-                            path,
-                            format!("array `{name}`: header says {len} B, found {} B", body.len()),
-                        ));
-                    }
-                    let values: Vec<f64> = match ty.as_str() {
-                        "Float64" => body
-                            .chunks_exact(8)
-                            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-                            .collect(),
-                        "Int64" => body
-                            .chunks_exact(8)
-                            .map(|c| i64::from_le_bytes(c.try_into().unwrap_or([0; 8])) as f64)
-                            .collect(),
-                        "UInt8" => body.iter().map(|&b| b as f64).collect(),
-                        other => {
-                            return Err(bad(path, format!("array `{name}` has unsupported type {other}")))
-                        }
-                    };
+                    let values = decode(path, &ty, &name, &format, t.as_ref())?;
                     match section.as_str() {
                         "Points" => {
                             data.points =

@@ -71,3 +71,52 @@ print("ok")
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && stdout.trim() == "ok", "VTK rejected our files:\n{stdout}\n{stderr}");
 }
+
+#[test]
+fn vtk_reads_rectilinear_grids() {
+    if !vtk_available() {
+        assert!(
+            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
+            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
+        );
+        eprintln!("skipped: python3-vtk9 is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A stretched 3 × 2 × 1 grid; cell c = i + 3 j.
+    let x = [0.0, 0.1, 0.3, 0.7];
+    let (y, z) = ([0.0, 1.0, 3.0], [0.0, 0.5]);
+    let p: Vec<f64> = (0..6).map(|c| 10.0 * c as f64).collect();
+    let u: Vec<[f64; 3]> = (0..6).map(|c| [c as f64, 0.0, -1.0]).collect();
+    spatter_io::vtr::Vtr::new(&x, &y, &z)
+        .unwrap()
+        .cell_scalar("p_Pa", &p)
+        .cell_vector("U_m_s", &u)
+        .cell_int("blocked", &[0, 0, 1, 0, 0, 0])
+        .write(&dir.path().join("f.vtr"))
+        .unwrap();
+    let script = r#"
+import sys, vtk
+r = vtk.vtkXMLRectilinearGridReader(); r.SetFileName(sys.argv[1]); r.Update()
+if r.GetErrorCode() != 0: raise SystemExit("reader error %d" % r.GetErrorCode())
+g = r.GetOutput()
+assert g.GetDimensions() == (4, 3, 2), g.GetDimensions()
+assert g.GetNumberOfCells() == 6
+xs = g.GetXCoordinates()
+assert [xs.GetValue(i) for i in range(4)] == [0.0, 0.1, 0.3, 0.7]
+assert g.GetYCoordinates().GetValue(2) == 3.0
+# Cell (i=1, j=1): id 4 in VTK's order; its centre is at x = 0.2, y = 2.
+cid = g.ComputeCellId([1, 1, 0])
+assert cid == 4, cid
+assert g.GetCellData().GetArray("p_Pa").GetValue(cid) == 40.0
+assert g.GetCellData().GetArray("U_m_s").GetTuple3(cid) == (4.0, 0.0, -1.0)
+assert g.GetCellData().GetArray("blocked").GetValue(2) == 1
+b = [0.0] * 6; g.GetCell(cid).GetBounds(b)
+assert b[:4] == [0.1, 0.3, 1.0, 3.0], b
+print("ok")
+"#;
+    let out = Command::new(PYTHON).args(["-c", script]).arg(dir.path().join("f.vtr")).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stdout.trim() == "ok", "VTK rejected our .vtr:\n{stdout}\n{stderr}");
+}

@@ -78,6 +78,8 @@ kinds! {
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
     "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run),
         "A vehicle of named STL parts driving through a generated wading channel: wetting per part, sensors, splash heights.";
+    "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run),
+        "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
 }
@@ -127,7 +129,13 @@ fn load_source(source: Source) -> Result<Loaded, Vec<ScenarioError>> {
                 &source,
                 0,
                 Some("kind".into()),
-                format!("missing key `kind` at the top of the file; expected {}", expected()),
+                if table.contains_key("base") && table.contains_key("vary") {
+                    "this is a parameter study (it has `base` and `[[vary]]`), not a scenario: run it with \
+                     `spatter sweep FILE`"
+                        .to_owned()
+                } else {
+                    format!("missing key `kind` at the top of the file; expected {}", expected())
+                },
             )])
         }
     };

@@ -1,6 +1,6 @@
 //! Air drag on fluid particles.
 //!
-//! The thesis gives no drag equation (digest §2.12): the three tools only offer a switch (Preonlab force
+//! The truck wading thesis (Arjun & Michael 2022) gives no drag equation: the three tools only offer a switch (Preonlab force
 //! field, Simcenter tick-box, LS-DYNA `*DEFINE_SPH_AMBIENT_DRAG` with air density and viscosity). We use the
 //! standard drag of a sphere of the particle's volume, `F = ½ ρ_air C_D(Re) A |u_rel| u_rel` with
 //! `u_rel = u_air − v`, `A = π d²/4`, `d = (6V/π)^{1/3}`, `Re = ρ_air |u_rel| d / μ_air` and the

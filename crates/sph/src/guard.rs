@@ -1,7 +1,7 @@
 //! The crossing guard: no fluid particle passes through a wall or body surface, however thin.
 //!
 //! SPH wall forces alone cannot promise that (leaks through thin and fast walls are the classic complaint
-//! about established codes, DESIGN.md §4). After every drift, each particle that had a part's boundary
+//! about established codes). After every drift, each particle that had a part's boundary
 //! particles within its kernel support is checked against that part's surface triangles: its displacement
 //! over the step is expressed in the part's reference frame (old position with the part's old placement,
 //! new position with the new one, so wall motion counts too) and intersected with the triangles through

@@ -129,7 +129,7 @@ impl Kernel {
 ///
 /// `C(r) = 32/(π R⁹) · { (R − r)³ r³ if R/2 < r ≤ R;  2 (R − r)³ r³ − R⁶/64 if 0 < r ≤ R/2;  0 otherwise }`
 /// (Akinci, Akinci & Teschner 2013, "Versatile surface tension and adhesion for SPH fluids", ACM TOG 32(6)
-/// 182, eq. 2; the branch condition is garbled in the thesis extraction, digest §2.10.4).
+/// 182, eq. 2; the branch condition is garbled in the wading thesis's text).
 #[inline]
 pub fn akinci_cohesion(r: f64, support: f64) -> f64 {
     if r > support || r <= 0.0 {
@@ -249,7 +249,7 @@ mod tests {
 
     #[test]
     fn akinci_splines_match_the_tabulated_values() {
-        // Digest seed_002 §2.10.4, support radius 1: C(r)·h³ and A(r)·h³.
+        // Akinci et al. (2013), support radius 1: C(r)·h³ and A(r)·h³.
         let c = |r: f64| akinci_cohesion(r, 1.0);
         let a = |r: f64| akinci_adhesion(r, 1.0);
         for (r, want) in [

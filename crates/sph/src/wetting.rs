@@ -1,4 +1,5 @@
-//! Wetting maps at wall-particle resolution, independent of the surface mesh (DESIGN.md §4).
+//! Wetting maps at wall-particle resolution, independent of the surface mesh (marking a whole triangle wet
+//! when any particle touches it blurs the map and makes it change with the mesh size).
 //!
 //! Every first-layer wall particle carries its wet flag and accumulated wet time. A mesh part's triangles
 //! get the area-weighted mean of the particles covering them (see [`spatter_core::surface_sample`]): a

@@ -13,7 +13,9 @@
 //! * [`table`] — the results table, built from the case folders (so shards merge by collecting);
 //! * [`sensitivity`] — Saltelli design, Sobol first-order and total indices, Latin hypercube;
 //! * [`outputs`] — the study's plots, Sobol tables and report.
+//! * [`gallery`] — the same map of every case redrawn on one colour scale.
 
+pub mod gallery;
 pub mod keys;
 pub mod outputs;
 pub mod plan;

@@ -1,6 +1,7 @@
 //! What a finished study writes: the results and cost tables, a plot of every analysed output against
 //! every varied key, Sobol indices (table and chart) for a Sobol design, and `report.html`.
 
+use crate::gallery::{file_safe, redraw, Gallery};
 use crate::plan::{case_dir_name, Plan};
 use crate::sensitivity::{indices, Indices};
 use crate::spec::{design_name, DesignKind, Scale, StudyFile};
@@ -15,7 +16,7 @@ use std::path::{Path, PathBuf};
 const DEFAULT_PLOTTED: usize = 8;
 /// Rows of the results table shown in the report (the CSV has all).
 const REPORT_ROWS: usize = 200;
-/// Cases whose first picture the report shows side by side.
+/// Cases whose maps (or first picture) the report shows side by side.
 const GALLERY_CASES: usize = 36;
 
 /// Writes every output of a finished study into `out`; returns what it wrote, labelled.
@@ -71,8 +72,13 @@ pub fn write_all(
         }
     }
     written.extend(plots.iter().cloned());
+    let galleries = redraw(plan, out, GALLERY_CASES);
+    for g in &galleries {
+        written.push((format!("{} of every case on one colour scale", g.label), out.join("gallery")));
+    }
     let report = out.join("report.html");
-    study_report(study, plan, table, &outputs, &plots, &sobol, out)
+    let figures = Figures { plots: &plots, sobol: &sobol, galleries: &galleries };
+    study_report(study, plan, table, &outputs, &figures, out)
         .write(&report)
         .map_err(|source| StudyError::Io { path: report.clone(), source })?;
     written.push(("study report".into(), report));
@@ -94,10 +100,6 @@ fn analysed_outputs(study: &StudyFile, table: &Table) -> Result<Vec<String>, Stu
         }
     }
     Ok(study.spec.outputs.clone())
-}
-
-fn file_safe(s: &str) -> String {
-    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
 }
 
 /// `output` against varied key `i`: one line per combination of the other keys' values for a small grid,
@@ -188,15 +190,25 @@ fn sobol_chart(
 
 type SobolResult = (String, Vec<Indices>, PathBuf);
 
+/// The pictures a study report shows.
+struct Figures<'a> {
+    /// Each output against each varied key.
+    plots: &'a [(String, PathBuf)],
+    /// Sobol indices per output (Sobol designs).
+    sobol: &'a [SobolResult],
+    /// Maps of every case redrawn on one colour scale.
+    galleries: &'a [Gallery],
+}
+
 fn study_report(
     study: &StudyFile,
     plan: &Plan,
     table: &Table,
     outputs: &[String],
-    plots: &[(String, PathBuf)],
-    sobol: &[SobolResult],
+    figures: &Figures,
     out: &Path,
 ) -> Report {
+    let Figures { plots, sobol, galleries } = *figures;
     let title = study.spec.title.clone().unwrap_or_else(|| format!("Study {}", study.source.path.display()));
     let mut r = Report::new(&title);
     r.text(&format!(
@@ -283,10 +295,24 @@ fn study_report(
     if table.rows.len() > REPORT_ROWS {
         r.text(&format!("First {REPORT_ROWS} of {} cases; all are in results.csv.", table.rows.len()));
     }
+    for g in galleries {
+        r.heading(&format!("{}: every case on one colour scale", g.label));
+        r.text(&format!(
+            "Colour scale {} to {} ({}) for every case; each case's own pictures, on its own scale, are in its folder.",
+            spatter_io::plot::tick_label(g.scale.0),
+            spatter_io::plot::tick_label(g.scale.1),
+            g.colorbar_label
+        ));
+        let refs: Vec<(String, &Path)> = g.pictures.iter().map(|(l, p)| (l.clone(), p.as_path())).collect();
+        if let Err(e) = r.gallery(&refs) {
+            tracing::warn!("report: {e}");
+        }
+    }
     let gallery: Vec<(String, PathBuf)> = plan
         .cases
         .iter()
         .take(GALLERY_CASES)
+        .filter(|_| galleries.is_empty())
         .filter_map(|c| {
             let dir = out.join("cases").join(case_dir_name(c.index));
             let s = SummaryFile::read(&dir).ok().flatten()?;

@@ -1,5 +1,6 @@
-//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes.
+//! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes, flow scenes.
 
+pub mod cfd;
 pub mod dem_scene;
 pub mod deposition;
 pub mod snow;

@@ -7,8 +7,8 @@
 //!
 //! * zero-load contact radius a₀ = (9πΓR*²/(2E*))^{1/3} (thesis Eq. 17),
 //! * pull-off force F_c = (3/2)πΓR* (thesis Eq. 18),
-//! * critical overlap δ_c = a₀²/(2·6^{1/3}R*) (the minimum of δ(a); thesis Eq. 19 read as an overlap, see
-//!   `digests/seed_000_snow_dem.md` errata 4),
+//! * critical overlap δ_c = a₀²/(2·6^{1/3}R*) (the minimum of δ(a); thesis Eq. 19 read as an overlap; its
+//!   printed form is garbled),
 //! * overlap and force along the JKR curve: δ(a) = a²/R* − √(2πΓa/E*), F(a) = 4E*a³/(3R*) − √(8πΓE*a³),
 //!   positive F repulsive.
 //!
@@ -300,7 +300,7 @@ mod tests {
         ((a - b) / b).abs()
     }
 
-    /// Ice on ABS (snow thesis Table 2): E* = 1.88329e9 Pa (digest §3.5).
+    /// Ice on ABS (Lind 2017 Table 2): E* = 1.88329e9 Pa.
     fn ice_abs(d: f64) -> Jkr {
         let ice = spatter_core::material::Material::new(9.8e9, 0.31, 920.0).unwrap();
         let abs = spatter_core::material::Material::new(2.0e9, 0.35, 1100.0).unwrap();
@@ -308,8 +308,8 @@ mod tests {
     }
 
     #[test]
-    fn scales_match_snow_digest_table() {
-        // digests/seed_000_snow_dem.md §3.5 (flat ABS wall, Γ = 0.2): a₀, F_c, δ_c, δ₀, F(0) per diameter.
+    fn scales_match_snow_table() {
+        // Ice on a flat ABS wall, Γ = 0.2 (inputs of Lind 2017 Table 2): a₀, F_c, δ_c, δ₀, F(0) per diameter.
         // The table prints 5 significant digits: tolerance 1e-4 relative.
         let rows = [
             (10e-6, 3.3481e-07, 4.7124e-06, 6.1692e-09, 7.4734e-09, -4.1888e-06),
@@ -329,7 +329,7 @@ mod tests {
 
     #[test]
     fn forces_at_the_marked_points() {
-        // VERIFICATION.md "JKR adhesion": F(0) = −8/9 F_c; F = 0 at δ = a₀²/(3R*); F_min = −F_c at
+        // JKR theory (Johnson, Kendall & Roberts 1971): F(0) = −8/9 F_c; F = 0 at δ = a₀²/(3R*); F_min = −F_c at
         // δ = −0.48075 δ_c; at δ = −δ_c the contact radius is x = 6^{-2/3} and F = −5/9 F_c.
         // Newton converges to machine precision: tolerance 1e-10 (1e-6 at the double root −δ_c).
         let j = ice_abs(20e-6);
@@ -340,7 +340,7 @@ mod tests {
         assert!(rel(j.contact_radius(j.zero_force_overlap()).unwrap(), j.a0) < 1e-12);
         let d_lc = LOAD_CONTROLLED_BREAK_RATIO * j.critical_overlap;
         assert!(rel(j.force(d_lc).unwrap(), -fc) < 1e-10);
-        // The printed ratio 0.48075 (VERIFICATION.md) to its 5 digits.
+        // The load-controlled break ratio 0.48075 to its 5 digits.
         assert!((LOAD_CONTROLLED_BREAK_RATIO + 0.48075).abs() < 5e-6);
         let ds = -j.critical_overlap;
         assert!(rel(j.force(ds).unwrap(), -5.0 / 9.0 * fc) < 1e-6);
@@ -385,8 +385,8 @@ mod tests {
 
     #[test]
     fn neck_work_and_elastic_sticking_speed() {
-        // VERIFICATION.md / digest §2.4: W_neck = 0.935503 F_c δ_c; V_s = 1.367847 √(F_c δ_c/m).
-        // Digest §3.5 table: W_neck = 2.7196e-14 J and V_s = 0.3360 m/s at d = 10 µm (4 digits).
+        // Closed forms of the JKR curve: W_neck = 0.935503 F_c δ_c; V_s = 1.367847 √(F_c δ_c/m).
+        // With Lind's (2017) ice–ABS inputs: W_neck = 2.7196e-14 J and V_s = 0.3360 m/s at d = 10 µm (4 digits).
         let j = ice_abs(10e-6);
         let w = j.neck_work(BreakCriterion::CriticalOverlap);
         assert!(rel(w, 0.935503 * j.pull_off_force * j.critical_overlap) < 1e-6);

@@ -260,7 +260,7 @@ mod tests {
     #[test]
     fn jkr_law_follows_the_mechanics_through_the_kernel() {
         // The composed kernel with the JKR normal law reproduces F(0) = −8/9 F_c on first touch, keeps the
-        // neck at negative overlap and breaks below −δ_c (VERIFICATION.md, JKR).
+        // neck at negative overlap and breaks below −δ_c (JKR theory).
         let props = ice_abs_props(0.2);
         let law = Composed::new(JkrLaw::default(), NoDamping, Mindlin, NoRolling);
         let p = law.params(0, &props);
@@ -324,7 +324,7 @@ mod tests {
     fn cached_scales_give_the_same_forces_bit_for_bit() {
         // JkrContact keeps a₀ from the first evaluation; every later force must equal the one from JKR
         // scales recomputed at each call (Jkr::new + Jkr::evaluate), exactly, through loading, the neck and
-        // the break (VERIFICATION.md JKR points are covered by the mechanics tests).
+        // the break (the JKR curve's points are covered by the mechanics tests).
         let props = ice_abs_props(0.2);
         let law = JkrLaw::default();
         let p = law.params(0, &props);

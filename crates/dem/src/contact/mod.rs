@@ -36,7 +36,8 @@
 //!   force is repulsive, nor more tensile than an attractive elastic force:
 //!   F_n = max(F_ne + F_nd, min(F_ne, 0)). The damping coefficient is calibrated for the convention in
 //!   force ([`RestitutionDamping`]), so the realised coefficient of restitution equals the input e with the
-//!   clamp on or off (Chung & Ooi test 3). DESIGN.md §4 explains why this matters.
+//!   clamp on or off (Chung & Ooi test 3). With the clamp, the closed-form damping coefficient
+//!   realises a higher restitution than asked (e_in = 0.5 → 0.55), hence the fitted option.
 //! * **Coulomb force.** The tangential force is capped at μ·F_c where F_c is the normal law's choice
 //!   ([`NormalForce::coulomb_force`]); for Hooke and Hertz it is, by default, the total (clamped) normal
 //!   force including damping, so that tangential and normal impulses keep the ratio μ when sliding

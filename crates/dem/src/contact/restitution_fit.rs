@@ -15,7 +15,7 @@
 //!
 //! The familiar closed forms (β = ln e / √(ln²e + π²), c = 2|β| for p = 1, c = 2√(5/6)|β| for p = 3/2,
 //! LIGGGHTS/LAMMPS) are exact only for p = 1 without the clamp; for Hertz they miss e by up to ~10 % and
-//! with the clamp by more (e_in = 0.5 → e_out ≈ 0.55, DESIGN.md §4). Here c is found by integrating the
+//! with the clamp by more (e_in = 0.5 → e_out ≈ 0.55). Here c is found by integrating the
 //! equation above (classical RK4, 2000+ steps per contact) and inverting e(c), so a DEM run realises the
 //! requested e up to its own time-discretisation error.
 
@@ -318,7 +318,7 @@ mod tests {
 
     #[test]
     fn clamp_raises_the_realised_restitution_of_the_closed_form() {
-        // DESIGN.md §4: Hertz with the closed-form coefficient and a tensile clamp realises
+        // Hertz with the closed-form coefficient and a tensile clamp realises
         // e_in = 0.5 → ≈ 0.55 and e_in = 0.2 → ≈ 0.325 (two printed digits: tolerance 0.01).
         let c5 = linearised_coefficient(0.5, 1.5);
         let c2 = linearised_coefficient(0.2, 1.5);

@@ -69,7 +69,7 @@ fn rigid(nu: f64) -> Material {
 
 #[test]
 fn elastic_hertz_impact_matches_closed_forms() {
-    // Closed forms of VERIFICATION.md (Chung & Ooi 2011, Eq. 1–3), sphere on a rigid wall; 1 % tolerance
+    // Closed forms of Chung & Ooi (2011), Eq. 1–3, sphere on a rigid wall; 1 % tolerance
     // as in the reference table. R = 0.1, v = 0.2, Al alloy (test 2).
     let al = Material::new(70e9, 0.3, 2699.0).unwrap();
     let props = PairProps::new(&al, &rigid(0.3), 0.0, 1.0);
@@ -85,7 +85,7 @@ fn elastic_hertz_impact_matches_closed_forms() {
     assert!((d / d_max - 1.0).abs() < 0.01, "δ_max {d} vs {d_max}");
     assert!((t / tc - 1.0).abs() < 0.01, "t_c {t} vs {tc}");
     assert!((e - 1.0).abs() < 1e-3, "elastic e {e}");
-    // VERIFICATION.md numbers for Al: 11.37 kN, 49.72 µm, 731.7 µs.
+    // Chung & Ooi (2011) test 2 numbers for Al: 11.37 kN, 49.72 µm, 731.7 µs.
     assert!(
         (f / 11.37e3 - 1.0).abs() < 0.01
             && (d / 49.72e-6 - 1.0).abs() < 0.01
@@ -95,7 +95,7 @@ fn elastic_hertz_impact_matches_closed_forms() {
 
 #[test]
 fn calibrated_damping_realises_the_input_restitution_with_and_without_clamp() {
-    // Chung & Ooi test 3 (VERIFICATION.md): e_out = e_in. Tolerance 0.5 % at 400 steps per contact (the
+    // Chung & Ooi (2011) test 3: e_out = e_in. Tolerance 0.5 % at 400 steps per contact (the
     // time discretisation error of velocity Verlet with a velocity-dependent force).
     for clamp in [true, false] {
         for e_in in [0.2, 0.5, 0.8] {
@@ -115,7 +115,7 @@ fn calibrated_damping_realises_the_input_restitution_with_and_without_clamp() {
 
 #[test]
 fn linearised_damping_with_clamp_shows_the_known_restitution_shift() {
-    // DESIGN.md §4: closed-form damping and a tensile clamp give e_in = 0.5 → e_out ≈ 0.55.
+    // Known effect of a tensile clamp: closed-form damping with the clamp gives e_in = 0.5 → e_out ≈ 0.55.
     let law = Composed::new(
         Hertz,
         RestitutionDamping { calibration: RestitutionCalibration::Linearised, ..Default::default() },
@@ -373,7 +373,7 @@ fn the_standard_law_stores_only_its_tangential_history_per_contact() {
 #[test]
 fn speed_dependent_damping_fixes_its_coefficient_at_first_touch_only() {
     // The coefficient follows the impact speed of the first evaluation; later, slower evaluations of the
-    // same contact keep it (Thornton e(V) is a property of the impact, digest §2.5).
+    // same contact keep it (Thornton's e(V) is a property of the impact).
     use crate::restitution_models::{RestitutionModel, SpeedDependentDamping, SpeedDependentState};
     let law =
         SpeedDependentDamping { model: RestitutionModel::default(), base: RestitutionDamping::default() };

@@ -24,6 +24,10 @@ pub struct SlotOut {
     pub normal_force: f64,
     /// Normal approach speed −v_rel·n \[m/s\].
     pub approach_speed: f64,
+    /// Tangential speed of the particle centre relative to the wall, set in the evaluation in which the
+    /// contact formed (0 otherwise) \[m/s\].
+    #[serde(default)]
+    pub tangential_speed: f64,
     /// Contact force on the particle \[N\] (the wall gets the opposite).
     pub force: Vec3,
 }
@@ -96,6 +100,9 @@ impl<L: ContactLaw> Simulation<L> {
                     }
                 },
             );
+            if !self.st.bodies.is_empty() {
+                self.clear_member_base_forces();
+            }
         }
         // External work uses the velocities at evaluation time (half-step velocities under Verlet).
         let mut ext_power = 0.0;
@@ -213,11 +220,18 @@ impl<L: ContactLaw> Simulation<L> {
                                     acc.wall_power += o.force.dot(v_wall) + o.rolling_torque.dot(kw.omega);
                                     acc.wall_contacts += 1;
                                     acc.note_overlap(c.overlap / r, id[i], u32::MAX);
+                                    let tangential_speed = if was_new {
+                                        let vc = vel[i] - v_wall;
+                                        (vc - vc.dot(n) * n).length()
+                                    } else {
+                                        0.0
+                                    };
                                     *out = SlotOut {
                                         active: true,
                                         formed: was_new,
                                         normal_force: o.normal_force,
                                         approach_speed: -c.v_rel.dot(n),
+                                        tangential_speed,
                                         force: o.force,
                                     };
                                 }
@@ -440,22 +454,36 @@ impl<L: ContactLaw> Simulation<L> {
             acc = Acc::combine(acc, a);
         }
 
-        // Mesh impact records (sequential: slots of different particles share triangles).
+        // Mesh impact records and wear (sequential: slots of different particles share triangles).
         let wl = &self.st.wall_list;
-        for k in 0..wl.out.len() {
-            let o = wl.out[k];
-            if !o.active {
-                continue;
-            }
-            if let WallShape::Mesh(m) = &mut self.walls[wl.wall[k] as usize].shape {
-                let t = wl.tri[k] as usize;
-                let r = &mut m.records;
-                let ft = (o.force.length_squared() - o.normal_force * o.normal_force).max(0.0).sqrt();
-                r.normal_impulse[t] += o.normal_force.abs() * dt;
-                r.tangential_impulse[t] += ft * dt;
-                if o.formed {
-                    r.impacts[t] += 1;
-                    r.impact_speed_sum[t] += o.approach_speed;
+        let p = &self.particles;
+        let bodies = &self.st.bodies;
+        for i in 0..p.len() {
+            for k in wl.start[i] as usize..wl.start[i + 1] as usize {
+                let o = wl.out[k];
+                if !o.active {
+                    continue;
+                }
+                let wall = &mut self.walls[wl.wall[k] as usize];
+                let wall_material = wall.material as usize;
+                if let WallShape::Mesh(m) = &mut wall.shape {
+                    let t = wl.tri[k] as usize;
+                    let r = &mut m.records;
+                    let ft = (o.force.length_squared() - o.normal_force * o.normal_force).max(0.0).sqrt();
+                    r.normal_impulse[t] += o.normal_force.abs() * dt;
+                    r.tangential_impulse[t] += ft * dt;
+                    if o.formed {
+                        let v_n = o.approach_speed.max(0.0);
+                        r.impacts[t] += 1;
+                        r.impact_speed_sum[t] += o.approach_speed;
+                        r.impact_angle_sum[t] += v_n.atan2(o.tangential_speed).to_degrees();
+                        if let Some(model) = self.wear.get(p.material[i] as usize, wall_material) {
+                            // The impacting mass: the whole body for a clump member.
+                            let mass =
+                                if p.is_member(i) { bodies.mass(p.body[i] as usize) } else { p.mass(i) };
+                            r.eroded_mass[t] += model.eroded_mass(mass, v_n, o.tangential_speed);
+                        }
+                    }
                 }
             }
         }

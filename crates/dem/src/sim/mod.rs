@@ -16,6 +16,7 @@
 //!
 //! Symplectic Euler evaluates the forces first, then kicks by a full step and drifts.
 
+mod clumps;
 mod forces;
 mod integrate;
 mod neighbors;
@@ -45,6 +46,26 @@ pub struct Settings {
     pub max_overlap_fraction: f64,
     /// Particles whose centre leaves this box are removed and counted (none by default).
     pub domain: Option<Aabb>,
+    /// The mass a clump member stands for in its contacts (m* of the contact law).
+    #[serde(default)]
+    pub clump_contact_mass: ClumpContactMass,
+}
+
+/// The mass a clump member stands for in its contacts: the contact laws compute m* = 1/(1/mᵢ + 1/mⱼ) from
+/// it, so it sets the dashpot (restitution) of member contacts. No single value is exact for every
+/// contact geometry of a rigid body (the exact one, the body's effective mass at the contact point along
+/// the normal, depends on the contact); see docs/dem.md, "Clumps".
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClumpContactMass {
+    /// The body mass M (LIGGGHTS multisphere; default). A body hitting a wall with one member at its
+    /// centre of mass bounces with the pair's restitution; with k members sharing the load, each contact
+    /// is damped as if it carried the whole body.
+    #[default]
+    Body,
+    /// The member's share of the body mass by volume, M Vᵢ/ΣVⱼ: exact when all members touch at once
+    /// with equal loads (a dumbbell dropped flat), too light for a single member contact.
+    MemberShare,
 }
 
 impl Default for Settings {
@@ -55,6 +76,7 @@ impl Default for Settings {
             verlet_list: true,
             max_overlap_fraction: 0.25,
             domain: None,
+            clump_contact_mass: ClumpContactMass::Body,
         }
     }
 }
@@ -168,6 +190,9 @@ pub struct DynState<S> {
     pub r_max: f64,
     /// Book energies in the evaluations of the next step (residual method).
     pub energy_requested: bool,
+    /// Rigid bodies (clumps) whose members are in the particle store.
+    #[serde(default)]
+    pub bodies: crate::clump::Bodies,
 }
 
 impl<S> Default for DynState<S> {
@@ -187,6 +212,7 @@ impl<S> Default for DynState<S> {
             wall_list: WallList::default(),
             r_max: 0.0,
             energy_requested: false,
+            bodies: crate::clump::Bodies::default(),
         }
     }
 }
@@ -253,6 +279,10 @@ pub struct Simulation<L: ContactLaw> {
     /// How the energy budget is obtained (default: per contact).
     pub energy_method: EnergyMethod,
     pub(crate) st: DynState<L::State>,
+    /// Clump templates (shapes of the rigid bodies).
+    templates: Vec<crate::clump::ClumpTemplate>,
+    /// Erosion models per (particle material, wall material).
+    wear: crate::wear::WearTable,
     scratch: Scratch,
     external: Option<Box<dyn ExternalForces>>,
     /// Ids of the pair with the largest overlap in the last evaluation (second = `u32::MAX` for a wall).
@@ -293,6 +323,8 @@ impl<L: ContactLaw> Simulation<L> {
             settings,
             energy_method: EnergyMethod::PerContact,
             st: DynState::default(),
+            templates: Vec::new(),
+            wear: crate::wear::WearTable::new(0),
             scratch: Scratch::default(),
             external: None,
             last_worst: (0, 0),
@@ -396,7 +428,10 @@ impl<L: ContactLaw> Simulation<L> {
         }
         for (w, rec) in self.walls.iter_mut().zip(s.mesh_records) {
             match (&mut w.shape, rec) {
-                (WallShape::Mesh(m), Some(r)) if r.impacts.len() == m.mesh.triangles.len() => m.records = r,
+                (WallShape::Mesh(m), Some(r)) if r.impacts.len() == m.mesh.triangles.len() => {
+                    m.records = r;
+                    m.records.fill_missing();
+                }
                 (WallShape::Mesh(_), _) | (_, Some(_)) => {
                     return Err(format!("wall `{}` does not match the checkpoint", w.name));
                 }
@@ -406,6 +441,7 @@ impl<L: ContactLaw> Simulation<L> {
         self.particles = s.particles;
         self.evaluated_ids = self.particles.next_id();
         self.st = s.dynamic;
+        self.refresh_members();
         let n = self.st.wall_list.state.len();
         if self.st.wall_list.out.len() != n {
             self.st.wall_list.out.clear();
@@ -421,6 +457,24 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.needs_rebuild = true;
         self.st.forces_valid = false;
         self.walls.len() - 1
+    }
+
+    /// Sets the erosion models of mesh walls (per particle material × wall material; see [`crate::wear`]).
+    pub fn set_wear(&mut self, table: crate::wear::WearTable) {
+        self.wear = table;
+    }
+
+    /// The erosion models in use.
+    pub fn wear(&self) -> &crate::wear::WearTable {
+        &self.wear
+    }
+
+    /// Total eroded mass of wall `w` \[kg\] (0 for an analytic wall).
+    pub fn eroded_mass(&self, w: usize) -> f64 {
+        match &self.walls[w].shape {
+            WallShape::Mesh(m) => m.records.eroded_mass.iter().sum(),
+            _ => 0.0,
+        }
     }
 
     /// Installs the external-force hook.
@@ -490,12 +544,14 @@ impl<L: ContactLaw> Simulation<L> {
                     self.evaluate()?;
                 }
                 let vmax = self.kick_drift(0.5, true, true);
+                let vmax = vmax.max(self.bodies_kick(0.5, true, true));
                 self.advance_time(vmax);
                 self.half_step_velocities = true;
                 self.maybe_rebuild();
                 self.half_step_velocities = false;
                 self.evaluate()?;
                 self.kick_drift(0.5, false, false);
+                self.bodies_kick(0.5, false, false);
             }
             Integrator::SymplecticEuler => {
                 if self.st.needs_rebuild {
@@ -503,6 +559,7 @@ impl<L: ContactLaw> Simulation<L> {
                 }
                 self.evaluate()?;
                 let vmax = self.kick_drift(1.0, true, false);
+                let vmax = vmax.max(self.bodies_kick(1.0, true, false));
                 self.advance_time(vmax);
                 self.maybe_rebuild();
                 // Forces now belong to the previous positions.
@@ -548,6 +605,9 @@ impl<L: ContactLaw> Simulation<L> {
     /// Evaluates forces at the current state and checks for blow-up.
     fn evaluate(&mut self) -> Result<(), DemError> {
         self.compute_forces();
+        if !self.st.bodies.is_empty() {
+            self.reduce_body_forces();
+        }
         self.st.forces_valid = true;
         if self.st.last.max_overlap_ratio > self.settings.max_overlap_fraction {
             return Err(self.blow_up_overlap());
@@ -565,13 +625,20 @@ impl<L: ContactLaw> Simulation<L> {
         let mut rot = 0.0;
         let mut moment = Vec3::ZERO;
         for i in 0..p.len() {
-            if p.inv_mass[i] == 0.0 {
+            if p.inv_mass[i] == 0.0 || p.is_member(i) {
                 continue;
             }
             let m = p.mass(i);
             ke += 0.5 * m * p.vel[i].length_squared();
             rot += 0.5 * p.inertia(i) * p.omega[i].length_squared();
             moment += m * p.pos[i];
+        }
+        let b = &self.st.bodies;
+        for k in 0..b.len() {
+            let m = b.mass(k);
+            ke += 0.5 * m * b.vel[k].length_squared();
+            rot += b.rotational_energy(k);
+            moment += m * b.pos[k];
         }
         // Summed like the injected accounts, so the residual is exactly zero before the first step.
         let pot = -self.gravity.dot(moment);
@@ -644,4 +711,8 @@ impl<L: ContactLaw> Simulation<L> {
 }
 
 #[cfg(test)]
+mod clump_tests;
+#[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod wear_tests;

@@ -101,8 +101,10 @@ impl<L: ContactLaw> Simulation<L> {
         }
         wall_carry.sort_unstable_by_key(|c| c.0);
 
-        // 2. Domain: drop particles that left it.
+        // 2. Domain: drop particles that left it (a body leaves as a whole when its centre of mass does).
         if let Some(dom) = self.settings.domain {
+            let removed_members = self.remove_bodies_outside(&dom);
+            self.st.removed += removed_members as u64;
             let n0 = self.particles.len();
             let pos = self.particles.pos.clone();
             // The energy the removed particles take out of the budget. Between the kicks of velocity Verlet
@@ -113,14 +115,16 @@ impl<L: ContactLaw> Simulation<L> {
             let e = &mut self.st.energy;
             let back = if self.half_step_velocities { 0.5 * self.dt } else { 0.0 };
             for (i, &x) in pos.iter().enumerate() {
-                if p.inv_mass[i] > 0.0 && !dom.contains(x) {
+                if p.inv_mass[i] > 0.0 && !p.is_member(i) && !dom.contains(x) {
                     let m = p.mass(i);
                     e.injected_kinetic -= 0.5 * m * p.vel[i].length_squared();
                     e.injected_rotational -= 0.5 * p.inertia(i) * p.omega[i].length_squared();
                     e.injected_moment -= m * (x - back * p.vel[i]);
                 }
             }
-            self.particles.retain(|i| dom.contains(pos[i]));
+            let members = self.particles.body.clone();
+            let is_member = |i: usize| !members.is_empty() && members[i] != crate::clump::NO_BODY;
+            self.particles.retain(|i| is_member(i) || dom.contains(pos[i]));
             self.st.removed += (n0 - self.particles.len()) as u64;
         }
 
@@ -143,7 +147,13 @@ impl<L: ContactLaw> Simulation<L> {
         let p = &self.particles;
         let grid = &self.scratch.grid;
         let extra = range_pp + skin;
-        let both_frozen = |i: usize, j: usize| p.inv_mass[i] == 0.0 && p.inv_mass[j] == 0.0;
+        // Two frozen spheres or two members of one body never interact.
+        let body = &p.body;
+        let has_bodies = !body.is_empty();
+        let both_frozen = |i: usize, j: usize| {
+            (p.inv_mass[i] == 0.0 && p.inv_mass[j] == 0.0)
+                || (has_bodies && body[i] == body[j] && body[i] != crate::clump::NO_BODY)
+        };
         let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
@@ -297,6 +307,7 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.disp_walls = 0.0;
         self.st.needs_rebuild = false;
         self.st.rebuilds += 1;
+        self.refresh_members();
     }
 }
 

@@ -1,5 +1,5 @@
 //! Chung & Ooi (2011), "Benchmark tests for verifying discrete element modelling codes at particle impact
-//! level", Granular Matter 13:643–656 — tests 1 to 8 with the numbers of `VERIFICATION.md`.
+//! level", Granular Matter 13:643–656 — tests 1 to 8 with the numbers of that paper.
 //!
 //! Hertz normal, Mindlin tangential with history, restitution damping with the tensile clamp (the
 //! engine's defaults); test 6 also under the conventions of its reference curve. The "rigid plane" is a

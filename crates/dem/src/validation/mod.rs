@@ -1,10 +1,14 @@
 //! Verification cases of `spatter validate`: Chung & Ooi (2011) tests 1–8 (tests 2, 3, 4 and 6 also
 //! against an STL plane with the impact on a face, a shared edge and a shared vertex), energy
-//! conservation of an elastic gas, and a settled pile.
+//! conservation of an elastic gas, a settled pile, rigid multi-sphere bodies (template inertia,
+//! torque-free rotation, one-sphere clump, dumbbell impacts) and erosion wear (Finnie's f(γ), single
+//! impacts).
 
 pub mod bulk;
 pub mod chung_ooi;
+pub mod clumps;
 pub mod impact;
+pub mod wear;
 
 use spatter_core::validation::Case;
 
@@ -21,6 +25,14 @@ pub fn validation_cases() -> Vec<Case> {
         Case { name: "chung_ooi_8_small_on_large_sphere", run: chung_ooi::test8 },
         Case { name: "dem_elastic_box_energy", run: bulk::elastic_box },
         Case { name: "dem_settled_pile", run: bulk::settled_pile },
+        Case { name: "clump_template_inertia", run: clumps::template_inertia },
+        Case { name: "clump_torque_free_invariants", run: clumps::torque_free_body },
+        Case { name: "clump_intermediate_axis_flip", run: clumps::intermediate_axis },
+        Case { name: "clump_one_sphere_equals_free_sphere", run: clumps::one_sphere_clump },
+        Case { name: "clump_dumbbell_flat", run: clumps::dumbbell_flat },
+        Case { name: "clump_dumbbell_on_end", run: clumps::dumbbell_on_end },
+        Case { name: "wear_finnie_angle_function", run: wear::finnie_table },
+        Case { name: "wear_single_impact", run: wear::single_oblique_impact },
     ]
 }
 

@@ -52,6 +52,13 @@ pub struct MeshRecords {
     pub impacts: Vec<u64>,
     /// Σ normal approach speed at formation \[m/s\] (divide by `impacts` for the mean impact speed).
     pub impact_speed_sum: Vec<f64>,
+    /// Σ impact angle at formation, between the velocity relative to the wall and the wall plane
+    /// \[deg\] (divide by `impacts` for the mean).
+    #[serde(default)]
+    pub impact_angle_sum: Vec<f64>,
+    /// Eroded wall mass \[kg\] (wear models, [`crate::wear`]).
+    #[serde(default)]
+    pub eroded_mass: Vec<f64>,
 }
 
 impl MeshRecords {
@@ -61,7 +68,16 @@ impl MeshRecords {
             tangential_impulse: vec![0.0; n],
             impacts: vec![0; n],
             impact_speed_sum: vec![0.0; n],
+            impact_angle_sum: vec![0.0; n],
+            eroded_mass: vec![0.0; n],
         }
+    }
+
+    /// Sizes the records added after older checkpoints were written.
+    pub(crate) fn fill_missing(&mut self) {
+        let n = self.impacts.len();
+        self.impact_angle_sum.resize(n, 0.0);
+        self.eroded_mass.resize(n, 0.0);
     }
 }
 

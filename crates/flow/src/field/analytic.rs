@@ -1,6 +1,6 @@
 //! Analytic flow fields. A scenario lists one or more; their velocities add up.
 //!
-//! Vortices use the convention of Jasion (2013) eq. 6.14 (`digests/seed_003_brownout.md` §4.6): the
+//! Vortices use the convention of Jasion (2013) eq. 6.14: the
 //! core radius r_c is the radius of peak swirl, so the Lamb–Oseen vortex reads
 //! V_θ(r) = Γ/(2π r) · (1 − exp(−α r²/r_c²)) with α = 1.25643 (peak 0.7153 Γ/(2π r_c) at r = r_c).
 
@@ -262,7 +262,7 @@ mod tests {
 
     #[test]
     fn lamb_oseen_peak_and_far_field() {
-        // Peak at r = r_c: 0.7153 Γ/(2π r_c) (digests/seed_003_brownout.md §4.6, [D]).
+        // Peak at r = r_c: 0.7153 Γ/(2π r_c) (derived from the profile of Jasion (2013) eq. 6.14).
         let (g, rc) = (6.48, 0.17);
         let peak = lamb_oseen_swirl(g, rc, rc);
         assert!((peak / (g / (2.0 * PI * rc)) - 0.71533).abs() < 1e-5);

@@ -1,15 +1,15 @@
 //! Closed forms of the particle–surface contact that set the entrainment scales: the pull-off force of an
 //! adhering sphere and the damping of a linear spring–dashpot contact from a restitution coefficient.
 //!
-//! * **Pull-off** (Jasion 2013 eq. 3.54–3.55, `digests/seed_003_brownout.md` §3.2): a sphere of radius r
+//! * **Pull-off** (Jasion 2013 eq. 3.54–3.55): a sphere of radius r
 //!   (the smaller body, treated as adhering to a flat surface) with work of adhesion σ comes off at
 //!   F = (3/2)πσr (Johnson–Kendall–Roberts) or F = 2πσr (Derjaguin–Muller–Toporov). The thesis inverts
 //!   measured pull-off forces (Jones et al.: 20–40 nN at 6 µm, 10–20 nN at 35 µm; Ibrahim et al.: 34 nN at
 //!   72 µm) with the JKR form to get σ, hence σ = 2·10⁻⁴ J/m² of its Table 6.1 and of the force ranking.
-//! * **Damping from restitution** (Jasion eq. 3.64, digest §3.4): the linear contact
+//! * **Damping from restitution** (Jasion eq. 3.64): the linear contact
 //!   m δ̈ + c δ̇ + k δ = 0 rebounds, after half a damped period π/ω_d, with
 //!   e = exp(−πξ/√(1 − ξ²)), ξ = c/(2√(k m)); inverted, ξ = −ln e/√(π² + ln²e) and
-//!   c = 2ξ√(k m_eff) (the thesis prints c with the sign of ln e; digest §3.4).
+//!   c = 2ξ√(k m_eff) (the thesis prints c with the sign of ln e, which would make it negative).
 
 use std::f64::consts::PI;
 
@@ -81,7 +81,7 @@ mod tests {
     #[test]
     fn damping_ratio_limits_and_round_trip() {
         // e = 1: no damping; the linear contact with c = 2ξ√(km) rebounds with the e it was built for
-        // (digest §6.1 item 8: e = 0.5 reproduced), to 1e-14.
+        // (e = 0.5 reproduced), to 1e-14.
         assert_eq!(damping_ratio(1.0), 0.0);
         for e in [0.9, 0.5, 0.2, 1e-4] {
             let (k, m) = (2.0e3, 3.0e-6);

@@ -5,8 +5,7 @@
 //! a_D = f(Re) · (u_f − v_p) / τ_p,    τ_p = ρ_p d² / (18 μ),    f = C_D Re / 24,
 //!
 //! so that f = 1 is Stokes drag and every other law is a correction factor (Jasion 2013, eq. 3.32–3.34
-//! and L1466, with the sign of the printed expression corrected so that drag resists slip;
-//! `digests/seed_003_brownout.md` §2.2). For non-spherical particles d is the volume-equivalent diameter.
+//! and L1466, with the sign of the printed expression corrected so that drag resists slip). For non-spherical particles d is the volume-equivalent diameter.
 
 use super::{reynolds, stokes_time, Fluid};
 use serde::{Deserialize, Serialize};
@@ -174,8 +173,8 @@ mod tests {
     }
 
     #[test]
-    fn schiller_naumann_digest_values() {
-        // digests/seed_003_brownout.md §6.1 item 1: f(1) = 1.15, f(100) = 4.5489, f(800) = 15.8086.
+    fn schiller_naumann_closed_form_values() {
+        // Schiller & Naumann (1933), f = 1 + 0.15 Re^0.687 (Jasion 2013 eq. 3.84): f(1) = 1.15, f(100) = 4.5489, f(800) = 15.8086.
         assert!(rel(schiller_naumann_fd(1.0), 1.15) < 1e-12);
         assert!(rel(schiller_naumann_fd(100.0), 4.5489) < 5e-5);
         assert!(rel(schiller_naumann_fd(800.0), 15.8086) < 5e-5);
@@ -184,7 +183,7 @@ mod tests {
 
     #[test]
     fn di_felice_verification_values() {
-        // VERIFICATION.md: C_d(Re=1) = 29.4849, C_d(1000) = 0.61119, χ(10^1.5) = 3.05 (5 significant
+        // Di Felice (1994), C_d = (0.63 + 4.8/√Re)²: C_d(Re=1) = 29.4849, C_d(1000) = 0.61119, χ(10^1.5) = 3.05 (5 significant
         // figures as quoted).
         let law = DragLaw::DiFelice { voidage: None };
         assert!(rel(law.cd(1.0), 29.4849) < 2e-6);
@@ -238,7 +237,7 @@ mod tests {
         let v = DragLaw::Stokes.terminal_speed(&air, d, 2480.0, 9.81);
         let expect = (2480.0 - 1.19) * 9.81 * d * d / (18.0 * 1.82e-5);
         assert!(rel(v, expect) < 1e-12);
-        // digests/seed_003_brownout.md §6.1 item 10: r_p = 5 µm → 7.43 mm/s (≈ v_ind/800 = 7.5 mm/s).
+        // Stokes settling of Jasion's (2013) sand: r_p = 5 µm → 7.43 mm/s (≈ v_ind/800 = 7.5 mm/s).
         assert!((v - 7.43e-3).abs() < 0.01e-3, "{v}");
         // Schiller–Naumann: the returned speed satisfies the force balance.
         let d = 300e-6;

@@ -1,7 +1,7 @@
 //! The Basset (history) force.
 //!
-//! Boussinesq–Basset term of the Maxey–Riley equation (Jasion 2013 eq. 3.35, 3.37;
-//! `digests/seed_003_brownout.md` §2.3), per unit mass, with w = u_f − v_p:
+//! Boussinesq–Basset term of the Maxey–Riley equation (Jasion 2013 eq. 3.35,
+//! 3.37), per unit mass, with w = u_f − v_p:
 //!
 //! F_B/m = K_B C_H/6 · [ ∫₀ᵗ (dw/dτ) / √(t − τ) dτ + w(0)/√t ],    K_B = 9 √(ρ_f μ) / (√π ρ_p d),
 //!
@@ -324,7 +324,7 @@ mod tests {
 
     #[test]
     fn odar_hamilton_values() {
-        // digests/seed_003_brownout.md §6.1 item 2 (printed form): C_B(0) = 1808.44, C_B(1) = 5.1008,
+        // Odar & Hamilton's coefficient as Jasion (2013) prints it: C_B(0) = 1808.44, C_B(1) = 5.1008,
         // C_B(∞) = 2.88 (5 significant figures).
         assert!((odar_hamilton_as_printed(0.0) - 1808.44).abs() < 0.01);
         assert!((odar_hamilton_as_printed(1.0) - 5.1008).abs() < 1e-4);

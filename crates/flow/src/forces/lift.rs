@@ -3,7 +3,8 @@
 //!
 //! Notation: `w = u_f − v_p` (fluid minus particle velocity), `omega_f = ∇×u_f` (fluid vorticity),
 //! `Ω = ω_p − ½ ω_f` (particle spin relative to the local fluid rotation). All results per unit mass
-//! (m/s²) or per unit moment of inertia (rad/s²). Sources and errata: `digests/seed_003_brownout.md` §2.4.
+//! (m/s²) or per unit moment of inertia (rad/s²). Source: Jasion (2013) chapter 3 (lift and torque), with the misprint noted at
+//! [`rotational_torque`].
 
 use super::Fluid;
 use spatter_core::Vec3;
@@ -107,7 +108,7 @@ pub fn torque_coefficient(law: TorqueLaw, re_rot: f64) -> f64 {
 /// dω/dt = (15 / (16π)) (ρ_f/ρ_p) C_M |Ω| (−Ω)
 ///
 /// from T = (ρ_f/2) r⁵ C_M |Ω| (−Ω) and I = (8/15) π ρ_p r⁵. Jasion eq. 3.44 prints 15π/16; substituting
-/// I puts π in the denominator (`digests/seed_003_brownout.md` §2.4, erratum 1). At low Re this is
+/// I puts π in the denominator (a misprint of the thesis). At low Re this is
 /// exactly Rubinow–Keller's T = −8πμ r³ Ω.
 pub fn rotational_torque(fluid: &Fluid, d: f64, rho_p: f64, spin_rel: Vec3, law: TorqueLaw) -> Vec3 {
     let om = spin_rel.length();
@@ -129,8 +130,9 @@ mod tests {
     }
 
     #[test]
-    fn closed_form_digest_values() {
-        // digests/seed_003_brownout.md §6.1 items 3–5, quoted to 5 significant figures: tolerance 5e-5.
+    fn closed_form_values() {
+        // Closed forms of Oesterle & Bui-Dinh (1998), Dennis et al. (1980) and Mei (1992) evaluated to 5
+        // significant figures: tolerance 5e-5.
         assert!(rel(oesterle_bui_dinh(10.0, 10.0), 0.86366) < 5e-5);
         assert!(rel(oesterle_bui_dinh(50.0, 100.0), 0.46695) < 5e-5);
         assert!(rel(torque_coefficient(TorqueLaw::Dennis, 10.0), 20.1062) < 5e-5);

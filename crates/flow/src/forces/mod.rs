@@ -1,8 +1,8 @@
 //! The particle–fluid force library.
 //!
 //! Every force is returned **per unit particle mass** (an acceleration, m/s²) and every torque per unit
-//! moment of inertia (an angular acceleration, rad/s²), the convention of Jasion (2013), eq. 3.4–3.8
-//! (`digests/seed_003_brownout.md` §2.1). The relative velocity is written `w = u_f − v_p` (fluid minus
+//! moment of inertia (an angular acceleration, rad/s²), the convention of Jasion (2013), eq. 3.4–3.8.
+//! The relative velocity is written `w = u_f − v_p` (fluid minus
 //! particle) throughout, so that drag is `+w/τ`.
 //!
 //! * [`drag`] — Stokes, Schiller–Naumann, Di Felice (with and without the voidage factor) and

@@ -2,7 +2,7 @@
 //!
 //! Jasion (2013) nondimensionalises the particle equation with the particle diameter d₀, a velocity u₀,
 //! the densities and the viscosity, so that du*/dt* = Σ F_φ0 F*_φ with every F*_φ of order one
-//! (eq. 3.80, 3.86–3.96, Table 6.3; `digests/seed_003_brownout.md` §2.7, §6.2). The reference terms are
+//! (eq. 3.80, 3.86–3.96, Table 6.3 of Jasion 2013). The reference terms are
 //! reproduced exactly **as printed**, which is what gives Table 6.4:
 //!
 //! | term | F_φ0 |
@@ -16,11 +16,11 @@
 //! | friction | C_Fr (F_P0 + F_G0 − F_S0 − F_M0) |
 //! | Magnus moment | (15/(16π)) C_M ρ_f/ρ_p (Jasion prints 15π/16; erratum 1) |
 //!
-//! The Saffman and pull-off terms are not dimensionless as printed (the digest notes this); they are kept
+//! The Saffman and pull-off terms are not dimensionless as printed; they are kept
 //! because the thesis's conclusions rest on them. [`physical_magnitudes`] gives, next to them, the actual
 //! accelerations the force library computes at the reference state.
 //!
-//! Asperity inception (Jasion eq. 6.7–6.10, §6.3 of the digest): A_H = F_P0/0.37, the critical drag
+//! Asperity inception (Jasion eq. 6.7–6.10): A_H = F_P0/0.37, the critical drag
 //! coefficient A_H/F_D0 (= σ/(1.11 μ), independent of size: 9.90 for Table 6.1) and A_B = A_H/F_B0.
 
 use super::Fluid;
@@ -200,7 +200,7 @@ mod tests {
 
     #[test]
     fn reproduces_table_6_4() {
-        // Jasion (2013) Table 6.4, L2460–2470 (digests/seed_003_brownout.md §2.8, §6.2), 3 s.f.
+        // Jasion (2013) Table 6.4, 3 s.f.
         let r = reference_terms(&table_6_4_input());
         let expect: [(&str, [f64; 3]); 7] = [
             ("F_D0", [2.20e-3, 7.34e-5, 4.40e-5]),
@@ -233,7 +233,7 @@ mod tests {
 
     #[test]
     fn asperity_constants() {
-        // digests/seed_003_brownout.md §6.3: A_H = 2.18e-2, 7.27e-4, 4.36e-4; A_H/F_D0 = 9.90 for all;
+        // Jasion (2013) eq. 6.7–6.10 with Table 6.1: A_H = 2.18e-2, 7.27e-4, 4.36e-4; A_H/F_D0 = 9.90 for all;
         // A_B = 0.388, 7.09e-2, 5.49e-2 (3 s.f.).
         let r = reference_terms(&table_6_4_input());
         let a_h = &r.row("A_H").unwrap().values;

@@ -1,7 +1,6 @@
 //! Wall-bounded lift on a particle in a turbulent boundary layer.
 //!
-//! Mollinger & Nieuwstadt (1996) form, Jasion (2013) eq. 3.49 and Table 3.1
-//! (`digests/seed_003_brownout.md` §2.6):
+//! Mollinger & Nieuwstadt (1996) form, Jasion (2013) eq. 3.49 and Table 3.1:
 //!
 //! F_L⁺ = p (a⁺)^q,   F_L = F_L⁺ ρ_f ν²,   a⁺ = a u_*/ν = ½ Re_p*,   Re_p* = d u_*/ν,
 //!
@@ -191,7 +190,7 @@ mod tests {
 
     #[test]
     fn table_3_1_at_unit_a_plus_is_p() {
-        // digests/seed_003_brownout.md §6.1 item 6: at a⁺ = 1, F⁺ = p.
+        // Jasion (2013) Table 3.1: at a⁺ = 1 every law gives F⁺ = p.
         for (law, p) in [
             (WallLiftLaw::Saffman, 6.46),
             (WallLiftLaw::LeightonAcrivos, 9.22),

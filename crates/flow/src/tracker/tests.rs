@@ -464,7 +464,7 @@ fn default_basset_settings_follow_the_analytic_rise() {
     assert!(ours > 1.5 * exact, "truncation error not reproduced: {ours} vs {exact}");
 }
 
-/// Wall-bounded lift by hand from Jasion (2013) eq. 3.49–3.50 (digests/seed_003_brownout.md §2.6):
+/// Wall-bounded lift by hand from Jasion (2013) eq. 3.49–3.50:
 /// F = p (a⁺)^q ρ ν² · f_Zeng, a⁺ = Re*/2, Re* = d u_*/ν, with the Table 3.1 regime choice (Leighton–Acrivos
 /// below Re* = 0.6, Mollinger et al. below 5, Hall above) and Zeng et al. (2009)'s factor
 /// f = exp(−½δ(Re/250)^{4/3}) [exp(αδ^β) − λ], δ = y/d − ½, α = −exp(−0.3 + 0.025 Re), β = 0.8 + 0.01 Re,

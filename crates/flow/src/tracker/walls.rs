@@ -7,7 +7,7 @@
 //! * `trap` — the parcel stays where it hit (deposited);
 //! * `escape` — the parcel leaves the computation at the wall (counted as escaped);
 //! * `regime_map` — stick/bounce from the snow workflow's regime-map JSON (`spatter.regime_map.v1`,
-//!   `digests/seed_000_snow_dem.md` §5.3): the parcel sticks when its normal impact speed is below the
+//!   the stick/bounce map of Lind 2017): the parcel sticks when its normal impact speed is below the
 //!   critical speed of its diameter, v_n < v_crit(d), and — when set — its tangential speed is below
 //!   `max_tangential_speed_m_s` (the tangential condition of the thesis's CFD, L575) and the local wall
 //!   shear stress is below `max_wall_shear_pa` (aerodynamic rip-off); otherwise it bounces with the

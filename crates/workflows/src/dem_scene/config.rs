@@ -1,5 +1,8 @@
 //! The DEM scene configuration (`kind = "dem"` scenario files). Every key is documented in `docs/dem.md`.
 
+pub use super::clumps::{
+    ClumpMixConfig, MassBasisKind, Packing, RatioBasis, TemplateConfig, TemplateShape, WearConfig, WearKind,
+};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::distribution::SizeDistribution;
@@ -49,6 +52,12 @@ pub struct SceneConfig {
     /// Particles injected over time.
     #[serde(default)]
     pub inject: Vec<InjectConfig>,
+    /// Clump templates (rigid bodies made of spheres) by name.
+    #[serde(default)]
+    pub templates: BTreeMap<String, TemplateConfig>,
+    /// Erosion wear of mesh walls per (particle material, wall material).
+    #[serde(default)]
+    pub wear: Vec<WearConfig>,
     #[serde(default)]
     pub output: OutputConfig,
     /// Folder that relative file paths (meshes, motion tables) are resolved against; set by the loader
@@ -210,6 +219,9 @@ pub struct EngineConfig {
     /// dashpot, slip and rolling work in every step; about 15 % slower).
     #[serde(default = "residual")]
     pub energy_method: spatter_dem::sim::EnergyMethod,
+    /// The mass a clump member stands for in its contacts: `body` (default) or `member_share`.
+    #[serde(default)]
+    pub clump_contact_mass: spatter_dem::sim::ClumpContactMass,
 }
 
 fn residual() -> spatter_dem::sim::EnergyMethod {
@@ -232,6 +244,7 @@ impl Default for EngineConfig {
             impact_speed_m_s: None,
             track_energy: true,
             energy_method: residual(),
+            clump_contact_mass: Default::default(),
         }
     }
 }
@@ -425,8 +438,13 @@ pub enum FillMethod {
 pub struct FillConfig {
     pub material: String,
     pub region: RegionConfig,
-    /// Diameter distribution (diameters in metres), e.g. `{ kind = "mono", diameter = 0.004 }`.
-    pub size: SizeDistribution,
+    /// Diameter distribution of spheres (diameters in metres), e.g. `{ kind = "mono", diameter = 0.004 }`
+    /// (exactly one of `size` and `clumps`).
+    #[serde(default)]
+    pub size: Option<SizeDistribution>,
+    /// Rigid bodies of these templates instead of spheres (random fill only).
+    #[serde(default)]
+    pub clumps: Option<ClumpMixConfig>,
     #[serde(default)]
     pub method: FillMethod,
     /// Random fill: number of particles …
@@ -462,7 +480,12 @@ fn default_attempts() -> u64 {
 pub struct InjectConfig {
     pub material: String,
     pub region: RegionConfig,
-    pub size: SizeDistribution,
+    /// Diameter distribution of spheres (exactly one of `size` and `clumps`).
+    #[serde(default)]
+    pub size: Option<SizeDistribution>,
+    /// Rigid bodies of these templates instead of spheres.
+    #[serde(default)]
+    pub clumps: Option<ClumpMixConfig>,
     /// Rate in particles per second …
     #[serde(default)]
     pub particles_per_s: Option<f64>,
@@ -544,6 +567,31 @@ fn check_region(c: &mut Checker, key: &str, r: &RegionConfig) {
             c.positive("scale", *scale);
         }
     });
+}
+
+/// Exactly one of `size` (spheres) and `clumps` (rigid bodies), each valid.
+fn check_items(
+    c: &mut Checker,
+    size: Option<&SizeDistribution>,
+    clumps: Option<&ClumpMixConfig>,
+    templates: &[&str],
+) {
+    match (size, clumps) {
+        (Some(d), None) => {
+            if let Err(e) = d.check() {
+                c.fail("size", e);
+            }
+        }
+        (None, Some(m)) => super::clumps::check_mix(c, m, templates),
+        (Some(_), Some(_)) => {
+            c.fail("clumps", "give size (spheres) or clumps (rigid bodies), not both".to_string())
+        }
+        (None, None) => c.fail(
+            "size",
+            "missing: give size (a diameter distribution of spheres) or clumps (a mix of [templates])"
+                .to_string(),
+        ),
+    }
 }
 
 fn check_direction(c: &mut Checker, key: &str, v: Vec3) {
@@ -777,12 +825,40 @@ impl Validate for SceneConfig {
                 });
             });
         }
+        let template_names: Vec<&str> = self.templates.keys().map(String::as_str).collect();
+        for (name, t) in &self.templates {
+            c.nested("templates", |c| {
+                if name.is_empty() || name.contains(['/', '\\']) {
+                    c.fail(name, format!("template name \"{name}\" must be non-empty without slashes"));
+                }
+                c.nested(name, |c| t.validate(c))
+            });
+        }
+        for (i, w) in self.wear.iter().enumerate() {
+            c.element("wear", i, |c| {
+                check_material_name(c, self, "particle_material", &w.particle_material);
+                check_material_name(c, self, "wall_material", &w.wall_material);
+                w.validate(c);
+                let same = |o: &WearConfig| {
+                    o.particle_material == w.particle_material && o.wall_material == w.wall_material
+                };
+                if self.wear[..i].iter().any(same) {
+                    c.fail("wall_material", "an earlier [[wear]] entry has the same pair".to_string());
+                }
+            });
+        }
         for (i, f) in self.fill.iter().enumerate() {
             c.element("fill", i, |c| {
                 check_material_name(c, self, "material", &f.material);
                 check_region(c, "region", &f.region);
-                if let Err(e) = f.size.check() {
-                    c.fail("size", e);
+                check_items(c, f.size.as_ref(), f.clumps.as_ref(), &template_names);
+                if f.clumps.is_some() {
+                    if f.method == FillMethod::Lattice {
+                        c.fail("method", "clumps are placed by method = \"random\" only".to_string());
+                    }
+                    if f.frozen {
+                        c.fail("frozen", "frozen applies to spheres, not to clumps".to_string());
+                    }
                 }
                 c.finite_vec("velocity_m_s", f.velocity_m_s);
                 match f.method {
@@ -797,7 +873,11 @@ impl Validate for SceneConfig {
                     FillMethod::Lattice => {
                         if let Some(s) = f.spacing_m {
                             c.positive("spacing_m", s);
-                        } else if spatter_dem::insertion::max_diameter(&f.size).is_none() {
+                        } else if f
+                            .size
+                            .as_ref()
+                            .is_some_and(|d| spatter_dem::insertion::max_diameter(d).is_none())
+                        {
                             c.fail(
                                 "spacing_m",
                                 "a lattice fill with an unbounded size distribution needs spacing_m"
@@ -812,9 +892,7 @@ impl Validate for SceneConfig {
             c.element("inject", i, |c| {
                 check_material_name(c, self, "material", &j.material);
                 check_region(c, "region", &j.region);
-                if let Err(e) = j.size.check() {
-                    c.fail("size", e);
-                }
+                check_items(c, j.size.as_ref(), j.clumps.as_ref(), &template_names);
                 match (j.particles_per_s, j.kg_per_s) {
                     (Some(r), None) => c.positive("particles_per_s", r),
                     (None, Some(r)) => c.positive("kg_per_s", r),

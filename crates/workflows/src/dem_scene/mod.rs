@@ -1,6 +1,7 @@
 //! Scenes: a DEM simulation described by a configuration ([`SceneConfig`], the `kind = "dem"` scenario
 //! body) and run into a run folder by [`run`], with checkpoint and bit-identical resume.
 
+mod clumps;
 mod config;
 mod run;
 pub mod setup;

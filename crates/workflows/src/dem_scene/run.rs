@@ -5,15 +5,16 @@ use super::setup;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
 use spatter_core::control::Finished;
-use spatter_core::Aabb;
+use spatter_core::{Aabb, Vec3};
 use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
+use spatter_dem::clump::NewBody;
 use spatter_dem::contact::{
     Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
     RestitutionDamping,
 };
 use spatter_dem::error::DemError;
 use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
-use spatter_dem::output::{energy_row, write_mesh, write_particles, ENERGY_COLUMNS};
+use spatter_dem::output::{body_rows, energy_row, write_mesh, write_particles, BODY_COLUMNS, ENERGY_COLUMNS};
 use spatter_dem::restitution_models::{RestitutionModel, SpeedDependentDamping};
 use spatter_dem::sim::{SimState, Simulation};
 use spatter_dem::timestep;
@@ -30,6 +31,9 @@ struct Checkpoint<S> {
     injectors: Vec<InjectorState>,
     output_index: u64,
     csv_bytes: u64,
+    /// Bytes written to `bodies.csv` and `wear.csv` (0 when not written).
+    bodies_csv_bytes: u64,
+    wear_csv_bytes: u64,
     warnings: Vec<String>,
 }
 
@@ -152,10 +156,54 @@ struct Outputs {
     csv: CsvSeries,
     particles: PvdSeries,
     meshes: Vec<Option<PvdSeries>>,
+    /// `bodies.csv` (scenes with clump templates).
+    bodies: Option<CsvSeries>,
+    /// `wear.csv` (scenes with a wear model).
+    wear: Option<CsvSeries>,
     index: u64,
 }
 
+/// Columns of `wear.csv`: time, then per mesh wall its eroded mass and impacts so far.
+fn wear_columns<L: ContactLaw>(sim: &Simulation<L>) -> Vec<String> {
+    let mut cols = vec!["t_s".to_string()];
+    for w in (0..sim.walls.len()).filter(|&w| sim.is_mesh_wall(w)) {
+        let name = &sim.walls[w].name;
+        cols.push(format!("{name}_eroded_mass_kg"));
+        cols.push(format!("{name}_impacts"));
+    }
+    cols
+}
+
+fn wear_row<L: ContactLaw>(sim: &Simulation<L>) -> Vec<f64> {
+    let mut row = vec![sim.time()];
+    for w in 0..sim.walls.len() {
+        if let spatter_dem::walls::WallShape::Mesh(m) = &sim.walls[w].shape {
+            row.push(sim.eroded_mass(w));
+            row.push(m.records.impacts.iter().sum::<u64>() as f64);
+        }
+    }
+    row
+}
+
+/// Opens (or on resume, truncates and reopens) an optional CSV series.
+fn series(path: &std::path::Path, columns: &[String], resume: Option<u64>) -> Result<CsvSeries, DemError> {
+    let cols: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let r = match resume {
+        Some(bytes) => CsvSeries::resume(path, &cols, bytes),
+        None => CsvSeries::create(path, &cols),
+    };
+    r.map_err(|source| DemError::Io { path: path.to_owned(), source })
+}
+
 impl Outputs {
+    /// Flushes the CSV series.
+    fn flush(&mut self) -> Result<(), DemError> {
+        for s in [Some(&mut self.csv), self.bodies.as_mut(), self.wear.as_mut()].into_iter().flatten() {
+            s.flush().map_err(|source| DemError::Io { path: s.path().to_owned(), source })?;
+        }
+        Ok(())
+    }
+
     fn write<L: ContactLaw>(
         &mut self,
         cfg: &SceneConfig,
@@ -168,6 +216,14 @@ impl Outputs {
         };
         let e = sim.energy();
         self.csv.row(&energy_row(sim, &e)).map_err(io(self.csv.path()))?;
+        if let Some(b) = &mut self.bodies {
+            for row in body_rows(sim) {
+                b.row(&row).map_err(io(b.path()))?;
+            }
+        }
+        if let Some(w) = &mut self.wear {
+            w.row(&wear_row(sim)).map_err(io(w.path()))?;
+        }
         let t = sim.time();
         if cfg.output.particles_vtu {
             let rel = format!("particles/particles_{:05}.vtu", self.index);
@@ -214,6 +270,7 @@ fn run_with<L: ContactLaw>(
             (Some(a), Some(b)) => Some(Aabb::new(a, b)),
             _ => None,
         },
+        clump_contact_mass: e.clump_contact_mass,
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method =
@@ -222,7 +279,11 @@ fn run_with<L: ContactLaw>(
     for w in built.walls {
         sim.add_wall(w);
     }
-    let mut injectors = setup::injectors(cfg)?;
+    for t in built.templates {
+        sim.add_template(t);
+    }
+    sim.set_wear(built.wear);
+    let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
     let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
     let inject_every: Vec<u64> =
@@ -236,6 +297,11 @@ fn run_with<L: ContactLaw>(
         let p = p.to_owned();
         move |source| DemError::Io { path: p, source }
     };
+    let has_bodies = !sim.templates().is_empty();
+    let has_wear = !sim.wear().is_empty();
+    let bodies_path = dir.path("bodies.csv");
+    let wear_path = dir.path("wear.csv");
+    let body_columns: Vec<String> = BODY_COLUMNS.iter().map(|c| c.to_string()).collect();
     let warnings: Vec<String>;
     let mut out;
     if ctx.resume {
@@ -271,13 +337,29 @@ fn run_with<L: ContactLaw>(
             csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
             particles,
             meshes,
+            bodies: match has_bodies {
+                true => Some(series(&bodies_path, &body_columns, Some(ck.bodies_csv_bytes))?),
+                false => None,
+            },
+            wear: match has_wear {
+                true => Some(series(&wear_path, &wear_columns(&sim), Some(ck.wear_csv_bytes))?),
+                false => None,
+            },
             index: ck.output_index,
         };
         warnings = ck.warnings;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
-        for p in setup::initial_particles(cfg, &sim.walls)? {
+        let initial = setup::initial_particles(cfg, &sim.walls, sim.templates())?;
+        for p in initial.spheres {
             sim.add_particle(p);
+        }
+        for (template, material, body) in initial.bodies {
+            sim.add_clump(template, material, body)?;
+        }
+        for t in sim.templates() {
+            let path = dir.path(&format!("templates/{}.vtu", t.name));
+            spatter_dem::clump::fill::write_template_vtu(t, &path).map_err(io(&path))?;
         }
         warnings = time_step_warnings(cfg, &sim);
         for w in &warnings {
@@ -290,6 +372,14 @@ fn run_with<L: ContactLaw>(
             csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
             particles: PvdSeries::new(&pvd_path),
             meshes,
+            bodies: match has_bodies {
+                true => Some(series(&bodies_path, &body_columns, None)?),
+                false => None,
+            },
+            wear: match has_wear {
+                true => Some(series(&wear_path, &wear_columns(&sim), None)?),
+                false => None,
+            },
             index: 0,
         };
         out.write(cfg, &sim, ctx)?;
@@ -298,13 +388,15 @@ fn run_with<L: ContactLaw>(
     while sim.step_count() < total_steps {
         let stop = ctx.control.stop_requested();
         if stop || ctx.checkpoint_due() {
-            out.csv.flush().map_err(io(&csv_path))?;
+            out.flush()?;
             let ck = Checkpoint {
                 scene_hash: hash,
                 sim: sim.state(),
                 injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
                 output_index: out.index,
                 csv_bytes: out.csv.bytes_written(),
+                bodies_csv_bytes: out.bodies.as_ref().map_or(0, CsvSeries::bytes_written),
+                wear_csv_bytes: out.wear.as_ref().map_or(0, CsvSeries::bytes_written),
                 warnings: warnings.clone(),
             };
             ctx.save_checkpoint(&ck)?;
@@ -335,9 +427,50 @@ fn run_with<L: ContactLaw>(
             ctx.control.progress(sim.step_count(), total_steps);
         }
     }
-    out.csv.flush().map_err(io(&csv_path))?;
+    out.flush()?;
     let _ = std::fs::remove_file(dir.checkpoint_path());
-    Ok(summary(cfg, &sim, &injectors, &warnings, ctx))
+    let mut s = summary(cfg, &sim, &injectors, &warnings, ctx);
+    for (name, png) in write_wear_maps(&sim, ctx)? {
+        s.artifacts.push((format!("eroded mass map {name}"), png));
+    }
+    Ok(s)
+}
+
+/// For every mesh wall that a wear model applies to, `wear/<name>_eroded_mass.png`: the eroded mass per
+/// triangle at the end of the run, seen against the wall's area-weighted mean normal (the side the
+/// particles hit), with the global z axis (or y for a horizontal wall) towards the top.
+fn write_wear_maps<L: ContactLaw>(
+    sim: &Simulation<L>,
+    ctx: &RunContext,
+) -> Result<Vec<(String, std::path::PathBuf)>, DemError> {
+    let mut out = Vec::new();
+    let mats = sim.materials().len();
+    for wall in &sim.walls {
+        let spatter_dem::walls::WallShape::Mesh(m) = &wall.shape else { continue };
+        if !(0..mats).any(|p| sim.wear().get(p, wall.material as usize).is_some()) {
+            continue;
+        }
+        let k = spatter_dem::walls::WallKinematics::of(&wall.motion, sim.time());
+        let mut mesh = m.mesh.clone();
+        mesh.map_vertices(|v| k.pose.apply(v));
+        let n: Vec3 = (0..mesh.triangles.len()).map(|t| mesh.normal(t) * mesh.area(t)).sum();
+        let view = -n.normalize_or_zero();
+        let up = if view.cross(Vec3::Z).length() > 1e-3 { Vec3::Z } else { Vec3::Y };
+        let name = &wall.name;
+        let png = ctx.dir.path(&format!("wear/{name}_eroded_mass.png"));
+        spatter_io::plot::mesh_map_png(
+            &png,
+            &mesh,
+            &m.records.eroded_mass,
+            view,
+            up,
+            &format!("{name}: eroded mass per triangle ({})", sim.wear().names().join(", ")),
+            "eroded mass [kg]",
+        )
+        .map_err(|source| DemError::Io { path: png.clone(), source })?;
+        out.push((name.clone(), png));
+    }
+    Ok(out)
 }
 
 /// Places the particles injector `k` owes at the current time, clear of the particles present and of the
@@ -352,7 +485,29 @@ fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &R
     let existing: Vec<_> =
         (0..p.len()).filter(|&i| reach.contains(p.pos[i])).map(|i| (p.pos[i], p.radius[i])).collect();
     let postponed = inj.state.postponed;
-    let placed = inj.place(region, t, &existing, &WallClearance::new(&sim.walls, t));
+    let walls = WallClearance::new(&sim.walls, t);
+    if let Some(mix) = inj.clumps.clone() {
+        let placed = inj.place_clumps(region, t, &existing, &walls);
+        if postponed == 0 && inj.state.postponed > 0 {
+            let slot = inj.state.pending.unwrap_or(0.0) as usize;
+            tracing::warn!(
+                "inject[{k}]: at t = {t:.6} s the region had no room for the next body (template `{}`) in {} \
+                 random positions and orientations; it waits for the next placement (the run summary gives \
+                 the total)",
+                sim.templates()[mix.shapes[slot].template].name,
+                inj.attempts
+            );
+        }
+        for p in placed {
+            let body = NewBody { pos: p.pos, quat: p.quat, vel: inj.velocity, omega: Vec3::ZERO };
+            // The template and material were checked when the scene was built.
+            if let Err(e) = sim.add_clump(mix.shapes[p.slot].template, inj.material, body) {
+                tracing::error!("inject[{k}]: {e}");
+            }
+        }
+        return;
+    }
+    let placed = inj.place(region, t, &existing, &walls);
     if postponed == 0 && inj.state.postponed > 0 {
         tracing::warn!(
             "inject[{k}]: at t = {t:.6} s the region had no room for the next particle (diameter {:e} m) \
@@ -376,8 +531,14 @@ fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> 
         sizes.push((p.material[i] as usize, p.radius[i]));
     }
     for j in &cfg.inject {
-        if let Some(m) = cfg.materials.keys().position(|k| *k == j.material) {
-            sizes.push((m, 0.5 * setup::min_diameter(&j.size)));
+        let Some(m) = cfg.materials.keys().position(|k| *k == j.material) else { continue };
+        if let Some(size) = &j.size {
+            sizes.push((m, 0.5 * setup::min_diameter(size)));
+        }
+        for name in j.clumps.iter().flat_map(|c| c.templates.iter()) {
+            if let Some(t) = sim.templates().iter().find(|t| &t.name == name) {
+                sizes.push((m, t.spheres.iter().map(|s| s.1).fold(f64::INFINITY, f64::min)));
+            }
         }
     }
     let mats = sim.materials();
@@ -449,6 +610,27 @@ fn summary<L: ContactLaw>(
         e.dissipated,
         e.total()
     ));
+    if !sim.templates().is_empty() {
+        s.headline.push(format!(
+            "{} rigid bodies (clumps) of {} templates",
+            sim.bodies().len(),
+            sim.templates().len()
+        ));
+        s.scalar("bodies", sim.bodies().len() as f64);
+    }
+    if !sim.wear().is_empty() {
+        let mut total = 0.0;
+        for w in (0..sim.walls.len()).filter(|&w| sim.is_mesh_wall(w)) {
+            let m = sim.eroded_mass(w);
+            total += m;
+            s.scalar(&format!("eroded_mass_{}_kg", sim.walls[w].name), m);
+        }
+        s.scalar("eroded_mass_kg", total);
+        s.headline.push(format!(
+            "wear ({}): {total:.6e} kg eroded from the mesh walls",
+            sim.wear().names().join(", ")
+        ));
+    }
     for (name, value) in [
         ("particles", sim.particles.len() as f64),
         ("removed", sim.removed_count() as f64),
@@ -469,15 +651,22 @@ fn summary<L: ContactLaw>(
         100.0 * cfg.dt_s / sim.rayleigh_time(),
         sim.bytes_per_particle()
     ));
+    if !injectors.is_empty() {
+        let placed = |f: fn(&InjectorState) -> f64| injectors.iter().map(|(i, _)| f(&i.state)).sum::<f64>();
+        s.scalar("injected_count", placed(|st| st.inserted as f64));
+        s.scalar("injected_mass_kg", placed(|st| st.mass));
+    }
     for (k, (inj, _)) in injectors.iter().enumerate() {
         let t = sim.time();
         let target = match inj.rate {
-            InjectionRate::ParticlesPerSecond(_) => format!("{:.0} particles", inj.target(t)),
+            InjectionRate::ParticlesPerSecond(_) => format!("{:.0}", inj.target(t)),
             InjectionRate::KgPerSecond(_) => format!("{:.6e} kg", inj.target(t)),
         };
         s.headline.push(format!(
-            "inject[{k}]: {} particles, {:.6e} kg placed (target {target})",
-            inj.state.inserted, inj.state.mass
+            "inject[{k}]: {} {}, {:.6e} kg placed (target {target})",
+            inj.state.inserted,
+            if inj.clumps.is_some() { "bodies" } else { "particles" },
+            inj.state.mass
         ));
         if inj.state.postponed > 0 {
             s.headline.push(format!(
@@ -490,6 +679,12 @@ fn summary<L: ContactLaw>(
         s.headline.push(format!("warning: {w}"));
     }
     s.artifacts.push(("energy budget".into(), ctx.dir.path("energy.csv")));
+    if !sim.templates().is_empty() {
+        s.artifacts.push(("rigid bodies over time".into(), ctx.dir.path("bodies.csv")));
+    }
+    if !sim.wear().is_empty() {
+        s.artifacts.push(("eroded mass over time".into(), ctx.dir.path("wear.csv")));
+    }
     if cfg.output.particles_vtu {
         s.artifacts.push(("particles (ParaView)".into(), ctx.dir.path("particles.pvd")));
     }

@@ -8,15 +8,17 @@ use spatter_core::mesh::TriMesh;
 use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::rng::{seeded, Rng};
 use spatter_core::{Aabb, Vec3};
+use spatter_dem::clump::{ClumpTemplate, NewBody};
 use spatter_dem::contact::{PairProps, PairTable};
 use spatter_dem::error::DemError;
 use spatter_dem::insertion::{
-    lattice_fill, random_fill, FillTarget, InjectionRate, Injector, InjectorState, OverlapIndex, Region,
-    WallClearance,
+    lattice_fill, random_clump_fill, random_fill, ClumpMix, ClumpShape, FillTarget, InjectionRate, Injector,
+    InjectorState, OverlapIndex, Region, WallClearance,
 };
 use spatter_dem::particles::NewParticle;
 use spatter_dem::restitution_models::{RestitutionModel, YieldGeometry};
 use spatter_dem::walls::{Cylinder, MeshWall, Plane, Rectangle, Wall, WallShape};
+use spatter_dem::wear::WearTable;
 
 pub use spatter_dem::insertion::max_diameter;
 
@@ -40,6 +42,9 @@ pub struct Built {
     pub materials: Vec<Material>,
     pub pairs: PairTable<PairProps>,
     pub walls: Vec<Wall>,
+    /// Clump templates in the order of `[templates]` (alphabetical).
+    pub templates: Vec<ClumpTemplate>,
+    pub wear: WearTable,
 }
 
 impl Built {
@@ -158,7 +163,39 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         };
         walls.push(Wall { name: w.name.clone(), shape, material, motion });
     }
-    Ok(Built { materials, pairs, walls })
+    let mut templates = Vec::with_capacity(cfg.templates.len());
+    for (name, t) in &cfg.templates {
+        templates.push(t.build(name, |p| cfg.resolve(p))?);
+    }
+    let mut wear = WearTable::new(n);
+    for (i, w) in cfg.wear.iter().enumerate() {
+        let a = material_index(cfg, &w.particle_material, &format!("wear[{i}].particle_material"))?;
+        let b = material_index(cfg, &w.wall_material, &format!("wear[{i}].wall_material"))?;
+        wear.set(a as usize, b as usize, w.model());
+    }
+    Ok(Built { materials, pairs, walls, templates, wear })
+}
+
+/// The insertion mix of a `clumps` table: the named templates with their body masses at `density`
+/// \[kg/m³\] and probabilities per body from the ratios.
+pub fn clump_mix(
+    cfg: &SceneConfig,
+    mix: &ClumpMixConfig,
+    templates: &[ClumpTemplate],
+    density: f64,
+) -> Result<ClumpMix, DemError> {
+    let mut shapes = Vec::with_capacity(mix.templates.len());
+    for (k, name) in mix.templates.iter().enumerate() {
+        let index = cfg.templates.keys().position(|t| t == name).ok_or_else(|| DemError::Config {
+            key: format!("clumps.templates[{k}]"),
+            message: format!("template \"{name}\" is not in [templates]"),
+        })?;
+        let t = &templates[index];
+        let (mass, _, _) = t.body_mass(density);
+        shapes.push(ClumpShape { template: index, members: t.spheres.clone(), mass, volume: mass / density });
+    }
+    let masses: Vec<f64> = shapes.iter().map(|s| s.mass).collect();
+    Ok(ClumpMix::new(shapes, &super::clumps::mix_weights(mix, &masses)))
 }
 
 /// The engine region of a region configuration.
@@ -175,21 +212,71 @@ pub fn region(cfg: &SceneConfig, r: &RegionConfig) -> Result<Region, DemError> {
 /// Consecutive draws above the lattice spacing after which a lattice fill gives up.
 const LATTICE_REDRAWS: u32 = 10_000;
 
-/// The particles of the `fill` entries, in order, avoiding each other and `walls` (placed as at t = 0).
+/// What the fills place at t = 0.
+#[derive(Debug, Default)]
+pub struct Initial {
+    pub spheres: Vec<NewParticle>,
+    /// Rigid bodies: template index, material, placement.
+    pub bodies: Vec<(usize, u16, NewBody)>,
+}
+
+/// The spheres and rigid bodies of the `fill` entries, in order, avoiding each other and `walls` (placed
+/// as at t = 0).
 ///
 /// A random fill that cannot reach its `count` or `volume_fraction` (a drawn sphere found no free place
 /// in `max_attempts` random positions) is an error naming the key, with the number placed: running with
 /// fewer particles than asked for would be a different experiment. A lattice fill takes the sites that
 /// are inside the region and clear of walls and earlier fills; diameters larger than the spacing are
-/// redrawn (the lattice truncates the distribution there, and says so in the log).
-pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewParticle>, DemError> {
+/// redrawn (the lattice truncates the distribution there, and says so in the log). A clump fill places
+/// whole bodies in random orientations (random fill only); a body that finds no place is an error too.
+pub fn initial_particles(
+    cfg: &SceneConfig,
+    walls: &[Wall],
+    templates: &[ClumpTemplate],
+) -> Result<Initial, DemError> {
     let clear = WallClearance::new(walls, 0.0);
     let mut placed: Vec<(Vec3, f64)> = Vec::new();
-    let mut out = Vec::new();
+    let mut out = Initial::default();
     for (i, f) in cfg.fill.iter().enumerate() {
         let material = material_index(cfg, &f.material, &format!("fill[{i}].material"))?;
         let reg = region(cfg, &f.region)?;
         let mut rng: Rng = seeded(cfg.seed, 1000 + i as u64);
+        if let Some(mix) = &f.clumps {
+            let density = cfg.materials[&f.material].density;
+            let mix =
+                clump_mix(cfg, mix, templates, density).map_err(|e| prefixed(e, &format!("fill[{i}].")))?;
+            let (target, key) = match (f.count, f.volume_fraction) {
+                (None, Some(v)) => (FillTarget::VolumeFraction(v), "volume_fraction"),
+                (n, _) => (FillTarget::Count(n.unwrap_or(0)), "count"),
+            };
+            let got = random_clump_fill(&reg, &mix, target, &placed, &clear, f.max_attempts, &mut rng);
+            if let Some(slot) = got.stuck_at {
+                let name = &templates[mix.shapes[slot].template].name;
+                return Err(DemError::Config {
+                    key: format!("fill[{i}].{key}"),
+                    message: format!(
+                        "the region is full or too small: placed {} bodies; the next body (template `{name}`, \
+                         bounding radius {:.3e} m) found no position and orientation with every member sphere \
+                         inside the region, clear of walls and of earlier particles, in max_attempts = {} \
+                         tries. Enlarge the region, ask for fewer bodies, or raise max_attempts",
+                        got.bodies.len(),
+                        mix.shapes[slot].bounding_radius(),
+                        f.max_attempts
+                    ),
+                });
+            }
+            for b in &got.bodies {
+                let shape = &mix.shapes[b.slot];
+                for &(c, r) in &shape.members {
+                    placed.push((b.pos + b.quat * c, r));
+                }
+                let body = NewBody { pos: b.pos, quat: b.quat, vel: f.velocity_m_s, omega: Vec3::ZERO };
+                out.bodies.push((shape.template, material, body));
+            }
+            tracing::info!("fill[{i}]: {} bodies", got.bodies.len());
+            continue;
+        }
+        let Some(size) = &f.size else { continue };
         let spheres: Vec<(Vec3, f64)> = match f.method {
             FillMethod::Random => {
                 let (target, key) = match (f.count, f.volume_fraction) {
@@ -197,7 +284,7 @@ pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewPar
                     (None, Some(v)) => (FillTarget::VolumeFraction(v), "volume_fraction"),
                     (None, None) => (FillTarget::Count(0), "count"),
                 };
-                let got = random_fill(&reg, &f.size, target, &placed, &clear, f.max_attempts, &mut rng);
+                let got = random_fill(&reg, size, target, &placed, &clear, f.max_attempts, &mut rng);
                 if let Some(d) = got.stuck_at {
                     let reached = match target {
                         FillTarget::Count(n) => format!("placed {} of {n} particles", got.spheres.len()),
@@ -222,7 +309,7 @@ pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewPar
                 got.spheres
             }
             FillMethod::Lattice => {
-                let d_max = max_diameter(&f.size);
+                let d_max = max_diameter(size);
                 let spacing = f.spacing_m.or(d_max.map(|d| 1.01 * d)).unwrap_or(0.0);
                 let r_site = 0.5 * spacing;
                 let sites = lattice_fill(&reg, spacing, r_site, f.lattice);
@@ -242,7 +329,7 @@ pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewPar
                     let d = match pending {
                         Some(d) => d,
                         None => {
-                            let mut d = f.size.sample(&mut rng);
+                            let mut d = size.sample(&mut rng);
                             let mut k = 0;
                             while d > spacing {
                                 k += 1;
@@ -255,7 +342,7 @@ pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewPar
                                         ),
                                     });
                                 }
-                                d = f.size.sample(&mut rng);
+                                d = size.sample(&mut rng);
                             }
                             redraws += k as u64;
                             d
@@ -283,15 +370,26 @@ pub fn initial_particles(cfg: &SceneConfig, walls: &[Wall]) -> Result<Vec<NewPar
             let mut p = NewParticle::at(x, r, material);
             p.vel = f.velocity_m_s;
             p.frozen = f.frozen;
-            out.push(p);
+            out.spheres.push(p);
         }
         placed.extend(spheres);
     }
     Ok(out)
 }
 
+/// A configuration error with its key prefixed (e.g. by `fill[0].`).
+fn prefixed(e: DemError, prefix: &str) -> DemError {
+    match e {
+        DemError::Config { key, message } => DemError::Config { key: format!("{prefix}{key}"), message },
+        e => e,
+    }
+}
+
 /// The injectors of the `inject` entries with their regions.
-pub fn injectors(cfg: &SceneConfig) -> Result<Vec<(Injector, Region)>, DemError> {
+pub fn injectors(
+    cfg: &SceneConfig,
+    templates: &[ClumpTemplate],
+) -> Result<Vec<(Injector, Region)>, DemError> {
     let mut out = Vec::new();
     for (i, j) in cfg.inject.iter().enumerate() {
         let material = material_index(cfg, &j.material, &format!("inject[{i}].material"))?;
@@ -300,10 +398,20 @@ pub fn injectors(cfg: &SceneConfig) -> Result<Vec<(Injector, Region)>, DemError>
             (None, Some(m)) => InjectionRate::KgPerSecond(m),
             (None, None) => InjectionRate::ParticlesPerSecond(0.0),
         };
+        let density = cfg.materials[&j.material].density;
+        let clumps = match &j.clumps {
+            Some(m) => Some(
+                clump_mix(cfg, m, templates, density).map_err(|e| prefixed(e, &format!("inject[{i}].")))?,
+            ),
+            None => None,
+        };
+        // A clump injector draws no diameters; its distribution is never sampled.
+        let dist = j.size.clone().unwrap_or(SizeDistribution::Mono { diameter: 0.0 });
         let inj = Injector {
-            dist: j.size.clone(),
+            dist,
+            clumps,
             rate,
-            density: cfg.materials[&j.material].density,
+            density,
             start: j.start_s,
             end: j.end_s.unwrap_or(f64::INFINITY),
             velocity: j.velocity_m_s,

@@ -138,7 +138,7 @@ fn validation_names_the_bad_keys() {
     cfg.pairs[0].materials[1] = "unobtainium".into();
     cfg.pair_defaults.restitution = 1.5;
     cfg.walls[0].material = "wood".into();
-    cfg.fill[0].size = spatter_core::distribution::SizeDistribution::Mono { diameter: -1.0 };
+    cfg.fill[0].size = Some(spatter_core::distribution::SizeDistribution::Mono { diameter: -1.0 });
     let errs = Checker::run(&cfg, None).unwrap_err();
     let find =
         |k: &str| errs.iter().find(|e| e.key == k).unwrap_or_else(|| panic!("no error for {k}: {errs:?}"));
@@ -318,7 +318,7 @@ fn fills_and_injections_cut_by_walls_create_no_overlaps_and_run() {
     let cfg = parse(&walls_in_the_way_toml(tmp.path()));
     Checker::run(&cfg, None).unwrap();
     let built = setup::build(&cfg).unwrap();
-    let ps = setup::initial_particles(&cfg, &built.walls).unwrap();
+    let ps = setup::initial_particles(&cfg, &built.walls, &built.templates).unwrap().spheres;
     let lattice = ps.len() - 200;
     assert!(lattice > 20, "{lattice} lattice particles");
     let clear_of_walls = |x: spatter_core::Vec3, r: f64| {
@@ -350,12 +350,12 @@ fn a_fill_that_does_not_fit_is_an_error_naming_the_key() {
     cfg.fill[0].count = Some(20_000);
     cfg.fill[0].max_attempts = 2000;
     let built = setup::build(&cfg).unwrap();
-    let err = setup::initial_particles(&cfg, &built.walls).unwrap_err().to_string();
+    let err = setup::initial_particles(&cfg, &built.walls, &built.templates).unwrap_err().to_string();
     assert!(err.starts_with("fill[0].count: the region is full: placed "), "{err}");
     assert!(err.contains("of 20000 particles") && err.contains("max_attempts = 2000"), "{err}");
     cfg.fill[0].count = None;
     cfg.fill[0].volume_fraction = Some(0.6);
-    let err = setup::initial_particles(&cfg, &built.walls).unwrap_err().to_string();
+    let err = setup::initial_particles(&cfg, &built.walls, &built.templates).unwrap_err().to_string();
     assert!(
         err.starts_with("fill[0].volume_fraction: the region is full: reached a solid fraction"),
         "{err}"
@@ -519,4 +519,110 @@ fn the_time_step_check_sees_the_smallest_diameter_a_distribution_can_draw() {
     // The normal's floor is max(mean − 3σ, mean/10): 0.4 mm and 0.1 mm here.
     assert_eq!(setup::min_diameter(&dists[2]), 1e-3 - 3.0 * 0.2e-3);
     assert_eq!(setup::min_diameter(&dists[3]), 0.1 * 1e-3);
+}
+
+/// Stones on the STL floor of [`pour_toml`]'s box: an ellipsoid template and a three-sphere template from
+/// an `x y z r` file, a clump fill and a mass-rate clump injection (ratios by mass), Finnie wear on the
+/// floor.
+fn stones_toml(dir: &Path) -> String {
+    let stl = floor_stl(dir);
+    let spheres = dir.join("rod.xyzr");
+    std::fs::write(&spheres, "x y z r\n-0.003 0 0 0.002\n0 0 0 0.002\n0.003 0 0 0.002\n").unwrap();
+    let mut text = pour_toml(&stl);
+    // Keep the box and the floor; the spheres give way to stones.
+    text.truncate(text.find("[[fill]]").unwrap());
+    text.push_str(&format!(
+        r#"
+[templates.pebble]
+shape = {{ type = "ellipsoid", semi_axes_m = [0.004, 0.003, 0.0025] }}
+packing = {{ type = "equal", sphere_diameter_m = 0.0016 }}
+
+[templates.rod]
+shape = {{ type = "spheres", file = "{}" }}
+
+[[fill]]
+material = "grain"
+region = {{ type = "box", min_m = [0, 0, 0.001], max_m = [0.06, 0.06, 0.03] }}
+clumps = {{ templates = ["pebble", "rod"], ratios = [1, 1] }}
+count = 20
+velocity_m_s = [0, 0, -0.5]
+
+[[inject]]
+material = "grain"
+region = {{ type = "box", min_m = [0, 0, 0.035], max_m = [0.06, 0.06, 0.06] }}
+clumps = {{ templates = ["pebble", "rod"], ratios = [3, 1], basis = "mass" }}
+kg_per_s = 0.05
+velocity_m_s = [0, 0, -0.5]
+interval_s = 0.005
+
+[[wear]]
+particle_material = "grain"
+wall_material = "steel"
+model = "finnie"
+k_s2_m2 = 1.0
+"#,
+        spheres.display()
+    ));
+    text
+}
+
+fn scalar(s: &spatter_io::run::RunSummary, name: &str) -> Option<f64> {
+    s.scalars.iter().find(|(k, _)| k == name).map(|(_, v)| *v)
+}
+
+#[test]
+fn a_stone_scene_runs_resumes_bit_for_bit_and_reports_its_wear() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = parse(&stones_toml(tmp.path()));
+    Checker::run(&cfg, None).unwrap();
+    let full = RunDir::create(&tmp.path().join("full")).unwrap();
+    let s = run(&cfg, &RunContext::new(&full, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.finished, Finished::Completed);
+    let part = RunDir::create(&tmp.path().join("part")).unwrap();
+    let stop = StopAfterPolls::new(333);
+    let p = run(&cfg, &RunContext::new(&part, &stop, false)).unwrap();
+    assert_eq!(p.finished, Finished::Interrupted);
+    let p = run(&cfg, &RunContext::new(&part, &Unattended, true)).unwrap();
+    assert_eq!(p.finished, Finished::Completed);
+    for rel in
+        ["energy.csv", "bodies.csv", "wear.csv", "particles/particles_00004.vtu", "walls/floor_00004.vtu"]
+    {
+        let a = std::fs::read(full.root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        let b = std::fs::read(part.root().join(rel)).unwrap();
+        assert!(a == b, "{rel} differs between the uninterrupted and the resumed run");
+    }
+    // The 20 filled bodies plus the injected ones. Placements every 5 ms from t = 0, the last at 35 ms
+    // (the run ends at 40 ms): 0.05 kg/s × 0.035 s within half a pebble (the heavier template:
+    // ρ 4/3 π abc = 2500 × 1.257e-7 m³ = 3.14e-4 kg, envelope mass).
+    let bodies = scalar(&s, "bodies").unwrap();
+    let injected_bodies = scalar(&s, "injected_count").unwrap();
+    assert!(injected_bodies >= 4.0, "{injected_bodies} bodies injected");
+    assert_eq!(bodies, 20.0 + injected_bodies, "no body left the domain");
+    let injected = scalar(&s, "injected_mass_kg").unwrap();
+    assert!((injected - 0.05 * 0.035).abs() <= 0.5 * 3.15e-4, "injected {injected} kg");
+    // Every member sphere in the particle VTU carries its body id; bodies.csv has one row per body.
+    let vtu = spatter_io::vtu::read(&full.root().join("particles/particles_00004.vtu")).unwrap();
+    let ids = &vtu.point_data["body_id"].1;
+    assert!(ids.iter().all(|&b| b >= 0.0), "only members, no free spheres");
+    let mut distinct: Vec<i64> = ids.iter().map(|&b| b as i64).collect();
+    distinct.sort();
+    distinct.dedup();
+    assert_eq!(distinct.len() as f64, bodies);
+    let csv = std::fs::read_to_string(full.root().join("bodies.csv")).unwrap();
+    let t_end = csv.lines().last().unwrap().split(',').next().unwrap().to_owned();
+    let last_rows = csv.lines().filter(|l| l.split(',').next() == Some(t_end.as_str())).count();
+    assert_eq!(last_rows as f64, bodies);
+    // Wear: the falling stones erode the floor; the summary total equals the wear CSV's last row and the
+    // sum over the floor's triangles in the last wall VTU (the only mesh wall).
+    let total = scalar(&s, "eroded_mass_kg").unwrap();
+    assert!(total > 0.0, "eroded mass {total}");
+    let wear = std::fs::read_to_string(full.root().join("wear.csv")).unwrap();
+    assert!(wear.starts_with("t_s,floor_eroded_mass_kg,floor_impacts"), "{wear}");
+    let last: Vec<f64> = wear.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    assert_eq!(last[1], total);
+    let mesh = spatter_io::vtu::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
+    let per_triangle: f64 = mesh.cell_data["eroded_mass_kg"].1.iter().sum();
+    assert!((per_triangle - total).abs() <= 1e-12 * total, "{per_triangle} vs {total}");
+    assert!(full.root().join("wear/floor_eroded_mass.png").is_file());
+    assert!(full.root().join("templates/pebble.vtu").is_file());
 }

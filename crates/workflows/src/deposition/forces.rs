@@ -139,7 +139,7 @@ mod tests {
         let ctx = RunContext::new(&rd, &spatter_core::control::Unattended, false);
         let s = run(&table_6_4(), &ctx).unwrap();
         let text = std::fs::read_to_string(dir.path().join("force_ranking.csv")).unwrap();
-        // Table 6.4 drag reference for 10 µm: 2.202e-3 (digests/seed_003_brownout.md §6.2).
+        // Table 6.4 drag reference for 10 µm: 2.202e-3 (Jasion 2013).
         let drag = text.lines().find(|l| l.starts_with("F_D0")).unwrap();
         let v: f64 = drag.split(',').nth(3).unwrap().parse().unwrap();
         assert!((v - 2.202e-3).abs() < 5e-7, "{drag}");

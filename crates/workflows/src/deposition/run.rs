@@ -29,7 +29,7 @@ use spatter_flow::tracker::walls::{Body, WallRule, WallRuleError, WallRuleSpec};
 use spatter_flow::tracker::{Status, TrackError, TrackSettings, Tracker, TrackerState};
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use std::path::PathBuf;
 
@@ -50,17 +50,14 @@ pub enum DepositionError {
     Io(#[from] std::io::Error),
     #[error("checkpoint: {0}")]
     Checkpoint(String),
-    #[error("cannot resume: {0}")]
-    Resume(String),
     #[error("invalid deposition configuration: {}", .0.iter().map(|e| format!("{} ({})", e.message, e.key)).collect::<Vec<_>>().join("; "))]
     Invalid(Vec<Invalid>),
 }
 
-/// What `checkpoint.bin` holds.
+/// What `checkpoint.bin` holds (its header names the input it belongs to: a resume with another
+/// configuration is refused when it is loaded).
 #[derive(Serialize, Deserialize)]
 pub(super) struct Checkpoint {
-    /// The configuration that wrote it (JSON), compared on resume.
-    pub(super) config: String,
     pub(super) state: TrackerState,
     pub(super) injectors: Vec<InjectorState>,
     pub(super) next_output: u64,
@@ -78,12 +75,6 @@ const BALANCE_COLUMNS: [&str; 9] = [
     "escaped_kg",
     "balance_residual_kg",
 ];
-
-/// The configuration as stored in (and compared with) the checkpoint. The scenario folder is not part
-/// of it, so a run folder can be resumed after the scenario moved.
-fn config_json(cfg: &DepositionConfig) -> String {
-    serde_json::to_string(cfg).unwrap_or_default()
-}
 
 /// Builds the flow field of `cfg`.
 pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
@@ -172,7 +163,6 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     // Scenario files are validated by the loader; a configuration built in Rust is checked here (a zero
     // dt_s would otherwise mean u64::MAX steps).
     Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DepositionError::Invalid)?;
-    let config = config_json(cfg);
     let field = build_field(cfg)?;
     let bodies = build_bodies(cfg, &field)?;
     let settings = TrackSettings {
@@ -203,12 +193,6 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     let mut next_output = 0u64;
     let (mut csv, mut pvd) = if ctx.resume && ckpt.is_file() {
         let c: Checkpoint = ctx.load_checkpoint().map_err(|e| DepositionError::Checkpoint(e.to_string()))?;
-        if c.config != config {
-            return Err(DepositionError::Resume(format!(
-                "{} was written by a different configuration; start afresh without --resume",
-                ckpt.display()
-            )));
-        }
         tr.state = c.state;
         for (inj, st) in injectors.iter_mut().zip(&c.injectors) {
             inj.restore(st);
@@ -244,7 +228,6 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
         if stop || ctx.checkpoint_due() {
             csv.flush()?;
             let c = Checkpoint {
-                config: config.clone(),
                 state: tr.state.clone(),
                 injectors: injectors.iter().map(Injector::state).collect(),
                 next_output,
@@ -367,22 +350,31 @@ fn write_bodies(
             .cell_scalar("wall_shear_estimate_pa", &body.wall_shear)
             .write(&ctx.dir.path(&rel))?;
         summary.artifacts.push((format!("{} deposit (VTU)", body.name), ctx.dir.path(&rel)));
-        let (values, label) = match cfg.output.picture_quantity {
-            PictureQuantity::MassPerArea => (mpa.clone(), "deposited mass per area [kg/m²]"),
-            PictureQuantity::Impacts => (d.impacts.iter().map(|&i| i as f64).collect(), "impacts [parcels]"),
-            PictureQuantity::MeanNormalSpeed => (d.mean_vn(), "mean normal impact speed [m/s]"),
+        // The picture's values and the VTU array that holds them (a study redraws it from there).
+        let (values, label, array) = match cfg.output.picture_quantity {
+            PictureQuantity::MassPerArea => {
+                (mpa.clone(), "deposited mass per area [kg/m²]", "mass_per_area_kg_m2")
+            }
+            PictureQuantity::Impacts => {
+                (d.impacts.iter().map(|&i| i as f64).collect(), "impacts [parcels]", "impacts")
+            }
+            PictureQuantity::MeanNormalSpeed => {
+                (d.mean_vn(), "mean normal impact speed [m/s]", "mean_normal_speed_m_s")
+            }
         };
         let png = ctx.dir.path(&format!("{}_deposit.png", body.name));
-        spatter_io::plot::mesh_map_png(
-            &png,
-            m,
-            &values,
-            spec.view_direction,
-            spec.view_up,
-            &format!("{}: {}{partial_note}", body.name, label.split(" [").next().unwrap_or(label)),
-            label,
-        )?;
+        let title = format!("{}: {}{partial_note}", body.name, label.split(" [").next().unwrap_or(label));
+        spatter_io::plot::mesh_map_png(&png, m, &values, spec.view_direction, spec.view_up, &title, label)?;
         summary.artifacts.push((format!("{} deposit (PNG)", body.name), png));
+        summary.maps.push(MeshMapRecord {
+            label: format!("{} deposit", body.name),
+            vtu: ctx.dir.path(&rel),
+            array: array.to_owned(),
+            view_dir: spec.view_direction.to_array(),
+            up: spec.view_up.to_array(),
+            title,
+            colorbar_label: label.to_owned(),
+        });
         let mass: f64 = d.mass.iter().sum();
         let area: f64 = areas.iter().sum();
         let impacts: u64 = d.impacts.iter().sum();

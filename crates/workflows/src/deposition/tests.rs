@@ -167,9 +167,11 @@ fn resuming_with_another_configuration_is_refused() {
     let mut other = cfg.clone();
     other.time.dt_s = 2.5e-4;
     let rd = RunDir::create(&out).unwrap();
-    let ctx = RunContext::new(&rd, &Unattended, true);
+    // The checkpoint carries the hash of the input that wrote it (the job driver stamps the resolved
+    // input's hash; `run_in` stamps 0), and the run loads it through the context.
+    let ctx = RunContext { input_hash: 12, ..RunContext::new(&rd, &Unattended, true) };
     let e = run(&other, &ctx).unwrap_err().to_string();
-    assert!(e.contains("checkpoint.bin") && e.contains("different configuration"), "{e}");
+    assert!(e.contains("checkpoint.bin") && e.contains("different scenario"), "{e}");
     // The checkpoint is left for the right configuration.
     assert!(out.join("checkpoint.bin").is_file());
     let s = run_in(&cfg, &out, &Unattended, true);

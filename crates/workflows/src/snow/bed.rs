@@ -1,10 +1,10 @@
 //! Rough walls: beds of frozen spheres, and the statistics of many impacts on them.
 //!
 //! The thesis made its rough wall by inserting 1 µm ABS spheres at random positions in a box, overlaps
-//! allowed, and raised the volume fraction "to receive a suitable surface roughness" (digest §2.8; the
-//! fractions are not published). [`random_insertion`] does exactly that; [`settled`] instead settles the
+//! allowed, and raised the volume fraction "to receive a suitable surface roughness" (Lind 2017;
+//! the fractions are not published). [`random_insertion`] does exactly that; [`settled`] instead settles the
 //! spheres geometrically into the box until no two overlap (a loose random packing; no dynamics).
-//! Bed spheres are frozen: infinite mass, no motion (digest §4.4 — free wall spheres give nonsense).
+//! Bed spheres are frozen: infinite mass, no motion (free wall spheres would be knocked away by the impacts).
 
 use super::impact::BedSphere;
 use spatter_core::grid::CellGrid;

@@ -13,6 +13,4 @@ pub enum SnowError {
     Io(#[from] io::Error),
     #[error("checkpoint: {0}")]
     Checkpoint(String),
-    #[error("cannot resume: {0}")]
-    Resume(String),
 }

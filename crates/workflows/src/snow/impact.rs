@@ -9,7 +9,7 @@
 //! # Set-up
 //!
 //! The particle starts exactly at first touch with its impact velocity (the thesis placed it so that the
-//! contact began at one fixed time step whatever the speed, digest §5.1): contact forms at step 0. The
+//! contact began at one fixed time step whatever the speed): contact forms at step 0. The
 //! wall normal is +z; the tangential velocity is along +x. For a sphere or a bed the start point is found
 //! by sweeping the particle along its straight approach path to the first touching partner.
 //!

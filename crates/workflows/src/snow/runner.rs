@@ -28,11 +28,10 @@ use spatter_dem::restitution_models::RestitutionModel;
 use spatter_io::plot::Chart;
 use spatter_io::run::{RunContext, RunSummary};
 
-/// What `checkpoint.bin` holds.
+/// What `checkpoint.bin` holds (its header names the input it belongs to: a resume with another
+/// configuration is refused when it is loaded).
 #[derive(Serialize, Deserialize)]
 struct Progress {
-    /// The configuration as JSON: a resume must use the same one.
-    config: String,
     records: Vec<ImpactRecord>,
     critical: Vec<CriticalSpeed>,
 }
@@ -63,27 +62,12 @@ fn run_chunks<J: Sync, R: Send>(
     Ok(Finished::Completed)
 }
 
-fn config_json(cfg: &SnowConfig) -> String {
-    serde_json::to_string(cfg).unwrap_or_default()
-}
-
-fn load_progress(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<Progress, SnowError> {
-    let fresh = Progress { config: config_json(cfg), records: Vec::new(), critical: Vec::new() };
-    if !ctx.resume {
+fn load_progress(ctx: &RunContext<'_>) -> Result<Progress, SnowError> {
+    let fresh = Progress { records: Vec::new(), critical: Vec::new() };
+    if !ctx.resume || !ctx.dir.checkpoint_path().exists() {
         return Ok(fresh);
     }
-    let path = ctx.dir.checkpoint_path();
-    if !path.exists() {
-        return Ok(fresh);
-    }
-    let p: Progress = ctx.load_checkpoint().map_err(|e| SnowError::Checkpoint(e.to_string()))?;
-    if p.config != fresh.config {
-        return Err(SnowError::Resume(format!(
-            "{} was written by a different configuration; start afresh without --resume",
-            path.display()
-        )));
-    }
-    Ok(p)
+    ctx.load_checkpoint().map_err(|e| SnowError::Checkpoint(e.to_string()))
 }
 
 fn save_progress(p: &Progress, ctx: &RunContext<'_>) -> Result<(), SnowError> {
@@ -315,7 +299,7 @@ fn chunk_size(jobs: usize) -> usize {
 fn run_grid(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, SnowError> {
     let jobs = grid_jobs(&cfg.grid);
     let model = model_of(cfg);
-    let mut p = load_progress(cfg, ctx)?;
+    let mut p = load_progress(ctx)?;
     ctx.control.status("snow regime map: grid");
     if run_chunks(&jobs, &mut p, |p| &mut p.records, chunk_size(jobs.len()), ctx, |j| run_job(&model, j))?
         == Finished::Interrupted
@@ -416,7 +400,7 @@ fn run_bisection(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, S
     let lo = cfg.bisection.speed_low_m_s.unwrap_or(v_lo);
     let hi = cfg.bisection.speed_high_m_s.unwrap_or(v_hi);
     let model = model_of(cfg);
-    let mut p = load_progress(cfg, ctx)?;
+    let mut p = load_progress(ctx)?;
     ctx.control.status("snow regime map: bisection");
     let tol = cfg.bisection.relative_tolerance;
     let exp = cfg.bisection.max_expansions;
@@ -506,7 +490,7 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
     let models: Vec<ImpactModel> = cases.iter().map(|c| model_of(&case_config(cfg, c))).collect();
     let jobs: Vec<(usize, usize)> =
         (0..cases.len()).flat_map(|c| (0..base_jobs.len()).map(move |j| (c, j))).collect();
-    let mut p = load_progress(cfg, ctx)?;
+    let mut p = load_progress(ctx)?;
     ctx.control.status("snow regime map: sensitivity study");
     if run_chunks(
         &jobs,
@@ -673,7 +657,7 @@ fn run_rough_wall(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, 
     let surface = Surface::bed(&bed, &index);
     let jobs: Vec<(usize, usize)> =
         (0..speeds.len()).flat_map(|i| (0..rw.impacts_per_speed).map(move |k| (i, k))).collect();
-    let mut p = load_progress(cfg, ctx)?;
+    let mut p = load_progress(ctx)?;
     ctx.control.status("snow regime map: rough wall");
     let run_one = |&(i, k): &(usize, usize)| {
         let aim = aim_point(cfg, (i * rw.impacts_per_speed + k) as u64);

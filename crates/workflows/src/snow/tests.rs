@@ -46,7 +46,7 @@ fn hertz_restitution_and_energy_through_the_driver() {
 
 #[test]
 fn chung_ooi_glass_spheres_particle_particle() {
-    // VERIFICATION.md, Chung & Ooi test 1: glass spheres R = 0.01 m at ±10 m/s, elastic, δ_max = 274.1 µm
+    // Chung & Ooi (2011) test 1: glass spheres R = 0.01 m at ±10 m/s, elastic, δ_max = 274.1 µm
     // (1 %). Here one sphere at rest is hit at 20 m/s (same relative motion); momentum is conserved and
     // the relative rebound speed equals the approach speed.
     let glass = spatter_core::material::Material::new(48e9, 0.2, 2800.0).unwrap();
@@ -104,7 +104,7 @@ fn rough_wall_start_touches_one_bed_sphere() {
     let model = model_of(&cfg);
     let index = super::bed_index::BedIndex::new(&bed.spheres);
     let surface = Surface::bed(&bed, &index);
-    // Slow impacts on a 1 µm bed stick (single-asperity v_crit ≈ 0.95 m/s, digest §4.4), fast ones mostly
+    // Slow impacts on a 1 µm bed stick (single-asperity v_crit ≈ 0.95 m/s, an independent computation of the model), fast ones mostly
     // bounce; every run ends decided.
     let mut fast_bounces = 0;
     for k in 0..8 {
@@ -134,7 +134,7 @@ fn small(mode: Mode) -> SnowConfig {
 #[test]
 fn ice_temperature_sets_the_particle_modulus() {
     use super::material::ice_youngs_modulus;
-    // Thesis Eq. 20 at −12 °C: 9.7724 GPa (digest §4.1 V3), to the 5 digits quoted.
+    // Thesis Eq. 20 at −12 °C: 9.7724 GPa (Lind 2017), to the 5 digits quoted.
     let cfg = SnowConfig { ice_temperature_c: Some(-12.0), ..small(Mode::Grid) };
     assert!((cfg.resolved().particle.youngs_modulus / 9.7724e9 - 1.0).abs() < 1e-5);
     assert_eq!(SnowConfig::default().resolved(), SnowConfig::default(), "no temperature: no change");
@@ -206,15 +206,19 @@ fn interrupted_and_resumed_runs_equal_uninterrupted_ones() {
 
 #[test]
 fn resume_refuses_a_different_configuration() {
+    // The checkpoint carries the hash of the input that wrote it (the job driver stamps the resolved
+    // input's hash); the snow run loads it through the context, so another input is refused.
     let root = tempfile::tempdir().unwrap();
     let cfg = small(Mode::Grid);
     let d = RunDir::create(root.path()).unwrap();
     let stop = StopAfterPolls::new(0);
-    assert_eq!(run(&cfg, &RunContext::new(&d, &stop, false)).unwrap().finished, Finished::Interrupted);
+    let first = RunContext { input_hash: 11, ..RunContext::new(&d, &stop, false) };
+    assert_eq!(run(&cfg, &first).unwrap().finished, Finished::Interrupted);
     let mut other = cfg.clone();
     other.grid.normal_speeds = 9;
-    let e = run(&other, &RunContext::new(&d, &Unattended, true)).unwrap_err();
-    assert!(e.to_string().contains("different configuration"), "{e}");
+    let e =
+        run(&other, &RunContext { input_hash: 12, ..RunContext::new(&d, &Unattended, true) }).unwrap_err();
+    assert!(e.to_string().contains("different scenario"), "{e}");
 }
 
 #[test]
@@ -372,11 +376,11 @@ fn sensitivity_checks_fail_on_doctored_counts() {
 #[test]
 fn material_report_uses_the_pair_of_each_target() {
     // Hand computation (ice on ABS, thesis Table 2; Γ = 0.2 J/m²; highest grid speed 16 m/s):
-    // E*(ice–ABS) = 1.88329e9 Pa and E*(ice–ice) = 5.42095e9 Pa (digest §3.5); R* = R₁R₂/(R₁ + R₂);
-    // m* = m₁m₂/(m₁ + m₂), m(10 µm) = 4.81711e-13 kg (digest §3.5); Tabor (R*Γ²/(E*²z₀³))^{1/3}
-    // (9.587 / 19.173 on the wall at R = 5 µm, digest §3.5); Hertz time 2.868(m*²/(R*E*²v))^{1/5}
+    // E*(ice–ABS) = 1.88329e9 Pa and E*(ice–ice) = 5.42095e9 Pa (from Lind 2017 Table 2); R* = R₁R₂/(R₁ + R₂);
+    // m* = m₁m₂/(m₁ + m₂), m(10 µm) = 4.81711e-13 kg; Tabor (R*Γ²/(E*²z₀³))^{1/3}
+    // (9.587 / 19.173 on the wall at R = 5 µm); Hertz time 2.868(m*²/(R*E*²v))^{1/5}
     // (Chung & Ooi 2011). Reference values below computed independently of the code; tolerance 1e-5
-    // relative (the digest's printed digits: 1e-4).
+    // relative (printed digits: 1e-4).
     let m10 = 4.817108735504351e-13;
     // (target, setting, E*, R*, m*, Tabor 0.4 nm, Tabor 0.2 nm, Hertz time at 16 m/s) at d = 10 µm.
     let rows = [
@@ -417,7 +421,7 @@ fn material_report_uses_the_pair_of_each_target() {
             assert!(close(c.m_star, m, 1e-12), "{name}: m* {}", c.m_star);
             assert!(close(c.tabor.0, t4, 1e-5) && close(c.tabor.1, t2, 1e-5), "{name}: {:?}", c.tabor);
             assert!(close(c.times.hertz, th, 1e-5), "{name}: t_H {}", c.times.hertz);
-            // Particle-only estimates: Rayleigh 8.402 ns, thesis Eq. 24 0.129 ns at 10 µm (digest §2.7, §4.1).
+            // Particle-only estimates: Rayleigh 8.402 ns, thesis Eq. 24 0.129 ns at 10 µm (Lind 2017).
             assert!(close(c.times.rayleigh, 8.402e-9, 1e-3) && close(c.times.thesis_eq24, 0.129e-9, 4e-3));
             // The time step used is the Hertz time of this pair at max(v, V_s,el) over 200 steps.
             assert!(close(c.dt, th / 200.0, 1e-9), "{name}: dt {} vs {}", c.dt, th / 200.0);
@@ -676,7 +680,7 @@ fn sample_impacts_write_the_target_they_hit() {
 
 #[test]
 fn critical_speed_is_invariant_under_gamma_diameter_scaling() {
-    // VERIFICATION.md, JKR section: with gravity off and e depending on the impact speed only,
+    // Scaling of the JKR impact (dimensional analysis): with gravity off and e depending on the impact speed only,
     // v_crit(kΓ, k·d) = v_crit(Γ, d). The driver has no gravity, and the default restitution (Thornton,
     // wall yield velocity, thesis Eq. 32) depends on V, E* and ρ but not on d. Under d → k·d, Γ → kΓ the
     // JKR scales go as F_c ∝ k², δ_c ∝ k, m ∝ k³, t_H ∝ k and the elastic sticking speed is unchanged, so
@@ -728,7 +732,7 @@ fn sticks_report_the_peak_overlap_of_the_first_compression() {
     // A grain slower than the elastic sticking speed is provably bound right after first touch, but the run
     // goes on to the first overlap maximum so that max_overlap is the real peak. Undamped (e = 1), energy
     // conservation fixes the peak: U(δ_max) = ½mv² with the closed-form JKR energy U (U(0) = 0 at touch;
-    // VERIFICATION.md JKR, digest §2.4). Tolerance 1e-3: time-step error of Verlet at 200 steps per Hertz
+    // JKR theory). Tolerance 1e-3: time-step error of Verlet at 200 steps per Hertz
     // time, O((ω Δt)²) ≈ 4e-4 in energy (measured 5e-6).
     use spatter_core::material::effective_modulus;
     use spatter_dem::adhesion::Jkr;

@@ -1,8 +1,7 @@
 //! Reference cases of the snow workflow for `spatter validate`.
 //!
-//! Sources: `VERIFICATION.md` (JKR section) and `digests/seed_000_snow_dem.md` (§2.4, §3.5, §4.1–4.4),
-//! i.e. closed-form JKR results, numbers printed in the snow thesis (Lind 2017) and the digest's own
-//! reference computations.
+//! Sources: closed-form JKR results (Johnson, Kendall & Roberts 1971), numbers printed in the snow thesis
+//! (Lind 2017) and reference computations of the model made independently of this code.
 
 use super::bisection::{critical_speed, BracketStatus};
 use super::cases::{case_config, model_of};
@@ -308,7 +307,7 @@ fn thesis_numbers(_quick: bool) -> Vec<Check> {
     ]
 }
 
-/// Flat-wall and frozen-sphere critical speeds against the digest's reference model.
+/// Flat-wall and frozen-sphere critical speeds against an independent computation of the model.
 fn critical_speeds(_quick: bool) -> Vec<Check> {
     let c = "snow_critical_speeds";
     let cfg = SnowConfig::default();

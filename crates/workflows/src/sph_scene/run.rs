@@ -359,15 +359,17 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
         let up = wcfg.and_then(|w| w.up).unwrap_or(du);
         let png = dir.path(&format!("wetting/{name}.png"));
         let (squares, fraction) = particle_map(&sim, k, elapsed);
-        spatter_io::plot::mesh_map_png_range(
+        let scale = match cfg.output.wetting_cap {
+            Some(cap) => (0.0, cap),
+            None => spatter_io::plot::auto_scale(&fraction),
+        };
+        spatter_io::plot::mesh_map_png_on_scale(
             &png,
             &squares,
             &fraction,
-            cfg.output.wetting_cap.map(|cap| [0.0, cap]),
-            view,
-            up,
-            &format!("{name}: fraction of time wet (0–{elapsed:.3} s)"),
-            "time wet / elapsed",
+            (view, up),
+            (&format!("{name}: fraction of time wet (0–{elapsed:.3} s)"), "time wet / elapsed"),
+            scale,
         )
         .map_err(io_at(&png))?;
         summary.artifacts.push((format!("wetting map {name}"), png));

@@ -9,6 +9,7 @@
 //!   fraction is reached. The diameters are drawn first and placed largest first; none is skipped, so
 //!   the placed sizes are an exact sample of the distribution.
 //! * [`Injector`]: the same random placement repeated over time at a number or mass rate.
+//! * [`clumps`]: the same for rigid multi-sphere bodies (random orientations, mixes of templates).
 
 use crate::walls::{Wall, WallKinematics};
 use serde::{Deserialize, Serialize};
@@ -19,6 +20,9 @@ use spatter_core::tri_bvh::TriBvh;
 use spatter_core::{Aabb, Vec3};
 use std::collections::HashMap;
 use std::f64::consts::PI;
+
+pub mod clumps;
+pub use clumps::{random_clump_fill, random_orientation, ClumpFill, ClumpMix, ClumpPlacement, ClumpShape};
 
 /// A region particles are placed in.
 #[derive(Clone, Debug)]
@@ -88,7 +92,7 @@ impl Region {
     }
 
     /// A uniformly random point of the bounding box.
-    fn sample(&self, rng: &mut Rng) -> Vec3 {
+    pub(crate) fn sample(&self, rng: &mut Rng) -> Vec3 {
         let b = self.bounds();
         let u = Vec3::new(rng.random(), rng.random(), rng.random());
         b.min + u * b.extent()
@@ -373,7 +377,8 @@ pub struct InjectorState {
     pub inserted: u64,
     /// Mass placed \[kg\].
     pub mass: f64,
-    /// A diameter drawn but not placed yet \[m\]: the next particle to place.
+    /// The next item to place, drawn but not placed yet: its diameter \[m\], or for a clump injector the
+    /// index of its template in the mix ([`Injector::clumps`]).
     pub pending: Option<f64>,
     /// Placement calls that ended with particles still owed because no free place was found.
     pub postponed: u64,
@@ -394,7 +399,11 @@ impl InjectorState {
 /// injected sizes follow the distribution exactly.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Injector {
+    /// Diameters of the spheres injected (unused when `clumps` is set).
     pub dist: SizeDistribution,
+    /// Inject rigid bodies of these templates instead of spheres.
+    #[serde(default)]
+    pub clumps: Option<ClumpMix>,
     pub rate: InjectionRate,
     /// Particle density \[kg/m³\].
     pub density: f64,
@@ -412,6 +421,22 @@ impl Injector {
     /// Mass of a sphere of diameter `d` \[kg\].
     pub fn mass_of(&self, d: f64) -> f64 {
         self.density * PI / 6.0 * d * d * d
+    }
+
+    /// Mass of a draw \[kg\]: a sphere of that diameter, or a body of that template slot.
+    fn mass_of_draw(&self, draw: f64) -> f64 {
+        match &self.clumps {
+            Some(mix) => mix.shapes[draw as usize].mass,
+            None => self.mass_of(draw),
+        }
+    }
+
+    /// The next draw: a diameter, or a template slot of the mix.
+    fn draw(&mut self) -> f64 {
+        match &self.clumps {
+            Some(mix) => mix.sample(&mut self.state.rng) as f64,
+            None => self.dist.sample(&mut self.state.rng),
+        }
     }
 
     /// Elapsed injection time at `t` \[s\] (0 before the start, held at the end).
@@ -438,14 +463,16 @@ impl Injector {
         }
     }
 
-    /// Whether a particle of diameter `d` is owed at time `t`.
+    /// Whether draw `d` (a diameter, or a template slot of a clump injector) is owed at time `t`.
     fn owes(&self, t: f64, d: f64) -> bool {
         if t < self.start {
             return false;
         }
         match self.rate {
             InjectionRate::ParticlesPerSecond(_) => self.due(t) > 0,
-            InjectionRate::KgPerSecond(m) => self.state.mass + 0.5 * self.mass_of(d) <= m * self.elapsed(t),
+            InjectionRate::KgPerSecond(m) => {
+                self.state.mass + 0.5 * self.mass_of_draw(d) <= m * self.elapsed(t)
+            }
         }
     }
 
@@ -459,16 +486,51 @@ impl Injector {
         existing: &[(Vec3, f64)],
         walls: &WallClearance,
     ) -> Vec<(Vec3, f64)> {
+        let mut index: Option<OverlapIndex> = None;
+        let attempts = self.attempts.max(1);
+        let dist = self.dist.clone();
+        self.place_owed(t, |d, rng| {
+            let index = index.get_or_insert_with(|| index_for(region, &dist, existing));
+            let r = 0.5 * d;
+            let x = try_place(region, r, index, walls, attempts, rng)?;
+            index.insert(x, r);
+            Some((x, r))
+        })
+    }
+
+    /// Places the bodies a clump injector ([`Injector::clumps`]) owes at time `t` in `region`, each at a
+    /// random position with a random orientation where every member lies inside the region and overlaps
+    /// neither the `existing` spheres nor `walls` nor the bodies placed before it. Stops early like
+    /// [`Injector::place`]. Returns nothing for a sphere injector.
+    pub fn place_clumps(
+        &mut self,
+        region: &Region,
+        t: f64,
+        existing: &[(Vec3, f64)],
+        walls: &WallClearance,
+    ) -> Vec<ClumpPlacement> {
+        let Some(mix) = self.clumps.clone() else { return Vec::new() };
+        let mut index: Option<OverlapIndex> = None;
+        let attempts = self.attempts.max(1);
+        self.place_owed(t, |slot, rng| {
+            let index = index.get_or_insert_with(|| clumps::index_for_mix(region, &mix, existing));
+            clumps::try_place_clump(region, &mix, slot as usize, index, walls, attempts, rng)
+        })
+    }
+
+    /// The rate logic shared by spheres and clumps: draws items (keeping an unplaced one as `pending`)
+    /// while the rate owes them, and places each with `try_one(draw, rng)`; stops at the first that finds
+    /// no place.
+    fn place_owed<P>(&mut self, t: f64, mut try_one: impl FnMut(f64, &mut Rng) -> Option<P>) -> Vec<P> {
         let mut out = Vec::new();
         if t < self.start {
             return out;
         }
-        let mut index: Option<OverlapIndex> = None;
         loop {
             let d = match self.state.pending {
                 Some(d) => d,
                 None => {
-                    let d = self.dist.sample(&mut self.state.rng);
+                    let d = self.draw();
                     self.state.pending = Some(d);
                     d
                 }
@@ -476,15 +538,12 @@ impl Injector {
             if !self.owes(t, d) {
                 return out;
             }
-            let index = index.get_or_insert_with(|| index_for(region, &self.dist, existing));
-            let r = 0.5 * d;
-            match try_place(region, r, index, walls, self.attempts.max(1), &mut self.state.rng) {
-                Some(x) => {
-                    index.insert(x, r);
+            match try_one(d, &mut self.state.rng) {
+                Some(p) => {
                     self.state.pending = None;
                     self.state.inserted += 1;
-                    self.state.mass += self.mass_of(d);
-                    out.push((x, r));
+                    self.state.mass += self.mass_of_draw(d);
+                    out.push(p);
                 }
                 None => {
                     self.state.postponed += 1;
@@ -552,6 +611,7 @@ mod tests {
     fn injector(dist: SizeDistribution, rate: InjectionRate, seed: u64) -> Injector {
         Injector {
             dist,
+            clumps: None,
             rate,
             density: 2500.0,
             start: 0.0,

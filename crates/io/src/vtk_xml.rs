@@ -1,0 +1,117 @@
+//! Pieces shared by the VTK XML writers and readers ([`crate::vtu`], [`crate::vtr`]): inline `binary`
+//! data arrays (base64 of a `UInt64` byte count followed by the little-endian values, one stream per
+//! array, no compression) and their decoding.
+
+use base64::Engine;
+use std::fmt::Write as _;
+use std::io;
+use std::path::Path;
+
+/// Values of one data array.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Values {
+    F64(Vec<f64>),
+    I64(Vec<i64>),
+}
+
+impl Values {
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            Values::F64(v) => v.len(),
+            Values::I64(v) => v.len(),
+        }
+    }
+}
+
+/// A named data array with `components` values per entity.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Array {
+    pub(crate) name: String,
+    pub(crate) components: usize,
+    pub(crate) values: Values,
+}
+
+/// Appends `array` to `list` after checking it holds `components` values for each of `expected` entities.
+/// A length mismatch is a programming error of the caller and panics with the array named.
+pub(crate) fn push(list: &mut Vec<Array>, expected: usize, name: &str, components: usize, values: Values) {
+    let len = values.len();
+    assert_eq!(len, expected * components, "VTK array `{name}`: {len} values for {expected} entities");
+    list.push(Array { name: name.to_owned(), components, values });
+}
+
+fn encode(bytes: &[u8]) -> String {
+    let mut raw = Vec::with_capacity(8 + bytes.len());
+    raw.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+    raw.extend_from_slice(bytes);
+    base64::engine::general_purpose::STANDARD.encode(raw)
+}
+
+/// Writes one `<DataArray>` element.
+pub(crate) fn write_array(s: &mut String, name: &str, components: usize, values: &Values) {
+    let (ty, bytes): (&str, Vec<u8>) = match values {
+        Values::F64(v) => ("Float64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+        Values::I64(v) => ("Int64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+    };
+    let _ = writeln!(
+        s,
+        "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{components}\" format=\"binary\">{}</DataArray>",
+        xml_escape(name),
+        encode(&bytes)
+    );
+}
+
+/// Writes one `<DataArray>` element of bytes.
+pub(crate) fn write_u8_array(s: &mut String, name: &str, values: &[u8]) {
+    let _ = writeln!(
+        s,
+        "        <DataArray type=\"UInt8\" Name=\"{name}\" NumberOfComponents=\"1\" format=\"binary\">{}</DataArray>",
+        encode(values)
+    );
+}
+
+/// Writes every array of `list` inside `<tag>…</tag>`.
+pub(crate) fn write_section(s: &mut String, tag: &str, list: &[Array]) {
+    let _ = writeln!(s, "      <{tag}>");
+    for a in list {
+        write_array(s, &a.name, a.components, &a.values);
+    }
+    let _ = writeln!(s, "      </{tag}>");
+}
+
+pub(crate) fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// An `InvalidData` error naming the file.
+pub(crate) fn bad(path: &Path, msg: impl std::fmt::Display) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidData, format!("{}: {msg}", path.display()))
+}
+
+/// Decodes the text of an inline binary `<DataArray>` of type `ty` (`Float64`, `Int64` or `UInt8`) into
+/// f64 values, checking the byte count in its header.
+pub(crate) fn decode(path: &Path, ty: &str, name: &str, format: &str, text: &[u8]) -> io::Result<Vec<f64>> {
+    if format != "binary" {
+        return Err(bad(path, format!("array `{name}` has format `{format}`; expected binary")));
+    }
+    let raw = base64::engine::general_purpose::STANDARD
+        .decode(text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect::<Vec<u8>>())
+        .map_err(|e| bad(path, format!("array `{name}`: bad base64: {e}")))?;
+    if raw.len() < 8 {
+        return Err(bad(path, format!("array `{name}` has no header")));
+    }
+    let len = u64::from_le_bytes(raw[..8].try_into().unwrap_or([0; 8])) as usize;
+    let body = &raw[8..];
+    if body.len() != len {
+        return Err(bad(path, format!("array `{name}`: header says {len} B, found {} B", body.len())));
+    }
+    Ok(match ty {
+        "Float64" => {
+            body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect()
+        }
+        "Int64" => {
+            body.chunks_exact(8).map(|c| i64::from_le_bytes(c.try_into().unwrap_or([0; 8])) as f64).collect()
+        }
+        "UInt8" => body.iter().map(|&b| b as f64).collect(),
+        other => return Err(bad(path, format!("array `{name}` has unsupported type {other}"))),
+    })
+}
