@@ -23,7 +23,8 @@ Examples:
   spatter bench dem                              # throughput of an engine
   spatter sweep examples/snow_sobol_study.toml   # parameter study: results table, Sobol indices, report
   spatter forces examples/forces_table_6_4.toml  # which particle-fluid forces matter, as a table and CSV
-  spatter sessile --adhesion 0.6,0.8,1.0         # SPH contact angle per wall adhesion factor (calibration)";
+  spatter sessile --adhesion 0.6,0.8,1.0         # SPH contact angle per wall adhesion factor (calibration)
+  spatter sessile --contact-angle glass=25       # adhesion factor that gives a measured contact angle";
 
 #[derive(Parser, Debug)]
 #[command(name = "spatter", version, about = "Particles that hit, stick to, wet and wear surfaces.", after_help = EXAMPLES)]
@@ -109,12 +110,21 @@ enum Command {
     /// SPH sessile drops: the static contact angle each wall adhesion factor gives, to calibrate `adhesion`
     /// against a measured contact angle (docs/sph.md, "Sessile-drop calibration").
     #[command(
-        after_help = "Examples:\n  spatter sessile --adhesion 0.6,0.8,1.0\n  spatter sessile --adhesion 0.9 --dimensions 3 --resolution 8 --csv angles.csv"
+        after_help = "Examples:\n  spatter sessile --adhesion 0.6,0.8,1.0\n  spatter sessile --adhesion 0.9 --dimensions 3 --resolution 8 --csv angles.csv\n  spatter sessile --contact-angle glass=25,paint=80,rubber=100 --dimensions 3 --resolution 6"
     )]
     Sessile {
         /// Wall adhesion factors (multiples of the liquid's cohesion), comma-separated, each in [0, 10].
-        #[arg(long, value_delimiter = ',', required = true, allow_hyphen_values = true)]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            allow_hyphen_values = true,
+            required_unless_present = "contact_angle"
+        )]
         adhesion: Vec<f64>,
+        /// Measured contact angles `material=degrees`, comma-separated (e.g. glass=25,paint=80): prints the
+        /// adhesion factor of each, from a table of drops over the factors 0.25–3 and one check per material.
+        #[arg(long, value_delimiter = ',', conflicts_with = "adhesion")]
+        contact_angle: Vec<String>,
         /// 2 (half-disc drop, the validated setting) or 3 (hemisphere).
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
         dimensions: u8,
@@ -224,6 +234,7 @@ fn main() -> ExitCode {
         Command::Forces { scenario, out } => commands::forces(&scenario, out.as_deref()),
         Command::Sessile {
             adhesion,
+            contact_angle,
             dimensions,
             resolution,
             radius_m,
@@ -233,6 +244,7 @@ fn main() -> ExitCode {
         } => commands::sessile::run(
             &commands::sessile::Request {
                 adhesion,
+                contact_angles: contact_angle,
                 dimensions,
                 resolution: resolution as usize,
                 radius_m,

@@ -214,6 +214,21 @@ fn deposition_resumes_bit_for_bit() {
 }
 
 #[test]
+fn wading_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for f in ["wading_truck_body.stl", "wading_truck_wheels.stl", "wading_truck_sensors.stl"] {
+        std::fs::copy(examples.join(f), dir.path().join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(examples.join("wading_truck.toml"))
+        .unwrap()
+        .replace("spacing_m = 0.05", "spacing_m = 0.12")
+        .replace("wetting_cap = 0.48", "wetting_cap = 0.48\nend_time_s = 0.006\nvtu_interval_s = 0.003");
+    let s = write(dir.path(), "wading.toml", text.as_bytes());
+    stop_and_resume(&s, 5, "wading");
+}
+
+#[test]
 fn flow_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");

@@ -76,6 +76,8 @@ kinds! {
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
     "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run),
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
+    "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run),
+        "A vehicle of named STL parts driving through a generated wading channel: wetting per part, sensors, splash heights.";
     "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run),
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),

@@ -5,6 +5,10 @@ use crate::kernel::{Dim, Kernel, KernelKind};
 use serde::{Deserialize, Serialize};
 use spatter_core::Vec3;
 
+/// Adhesion factors `[low, high]` of walls for which `spatter sessile` resolves a contact angle (see
+/// [`SphParams::adhesion_note`] and docs/sph.md, "Sessile-drop calibration").
+pub const ADHESION_CALIBRATED: [f64; 2] = [0.75, 3.0];
+
 /// Air drag on fluid particles (no equation in the thesis, digest §2.12; model choice in [`crate::drag`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DragParams {
@@ -185,6 +189,43 @@ impl SphParams {
         match self.dim {
             Dim::Two => std::f64::consts::PI / 2.0 * rho2 * gamma * moment,
             Dim::Three => 2.0 * std::f64::consts::PI / 3.0 * rho2 * gamma * moment,
+        }
+    }
+
+    /// Smallest sound speed \[m/s\] that keeps the compression of the liquid by its own cohesion and by a
+    /// wall of adhesion factor `adhesion` below about 1 %: `10 √(p_c max(1, f)/ρ₀)`, `p_c` the cohesive
+    /// pressure ([`SphParams::cohesive_pressure`]). The criterion `c₀ ≥ 10 √(p_max/ρ₀)` is the one the
+    /// weakly compressible Riemann-SPH codes use beside `c₀ ≥ 10 U_max`. An adhesive wall pulls the liquid
+    /// near it with about f times the cohesive pressure (the adhesion spline is scaled to the cohesion's
+    /// virial moment, [`SphParams::adhesion_per_factor`]); with the sound speed of the flow alone a factor of
+    /// 10 compressed the liquid at the wall by 20–30 % and the density window removed it. 0 without surface
+    /// tension.
+    pub fn capillary_sound_speed(&self, adhesion: f64) -> f64 {
+        let p = self.cohesive_pressure() * adhesion.max(1.0);
+        10.0 * (p / self.rest_density).sqrt()
+    }
+
+    /// Adhesion factors within which the sessile-drop calibration resolves a contact angle: at and below
+    /// 0.5 a resting drop does not wet the wall (180°: it balls up), so below
+    /// [`ADHESION_CALIBRATED`]`[0]` the angle is not resolved; above [`ADHESION_CALIBRATED`]`[1]` the wall
+    /// wets completely (the drop spreads to a film one to three spacings thick, θ below about 8° in 2D and
+    /// 13° in 3D), so a larger factor changes the angle little and mostly presses the film harder onto the
+    /// wall. See [`SphParams::adhesion_note`] and the tables of docs/sph.md.
+    pub fn adhesion_note(adhesion: f64) -> Option<String> {
+        let [lo, hi] = ADHESION_CALIBRATED;
+        if adhesion > 0.0 && adhesion < lo {
+            Some(format!(
+                "adhesion {adhesion} is below the calibrated range {lo}–{hi}: a resting drop wets such a wall little \
+                 or not at all (contact angle above about 70° in 2D and 120° in 3D, 180° from 0.5 down)"
+            ))
+        } else if adhesion > hi {
+            Some(format!(
+                "adhesion {adhesion} is above the calibrated range {lo}–{hi}: the wall already wets completely \
+                 (contact angle below about 8° in 2D and 13° in 3D); a larger factor mostly presses the water film \
+                 harder onto the wall"
+            ))
+        } else {
+            None
         }
     }
 

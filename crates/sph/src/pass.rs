@@ -108,6 +108,9 @@ pub(crate) struct FluidSet<'a> {
     pub c32: Coords32View<'a>,
     /// Akinci surface normals (empty without surface tension).
     pub nrm: &'a [Vec3],
+    /// Acceleration of each particle by the adhesion of all walls \[m/s²\] (empty without adhesion), for
+    /// the wall pressure.
+    pub adh: &'a [Vec3],
     pub grid: &'a NeighbourGrid,
 }
 
@@ -271,11 +274,51 @@ pub(crate) fn normals(kernel: &Kernel, c: &Consts, fl: FluidSet, gh: FluidSet, o
     })
 }
 
-/// Wall state of every entry of `wl`: Adami et al. (2012) pressure `p_b = (Σ p_f W + (g − a_b)·Σ ρ_f x_bf W)/Σ W`
+/// Akinci et al. (2013) adhesion acceleration of a fluid particle by wall entry `b`,
+/// `−β_b ρ₀ V_b A(r) x_ib/r` with `dx = x_i − x_b`, `r = |dx|` below the support (zero without adhesion).
+#[inline(always)]
+fn adhesion_pair(c: &Consts, wl: &WallSet, b: usize, dx: Vec3, r: f64) -> Vec3 {
+    let beta = c.beta[wl.part[b] as usize];
+    if beta == 0.0 || r <= 0.0 {
+        return Vec3::ZERO;
+    }
+    dx * (-beta * c.rho0 * wl.vol[b] * c.akinci.adhesion(r) / r)
+}
+
+/// The acceleration of every real fluid particle by the adhesion of all walls, `Σ_b` of
+/// [`adhesion_pair`], for the wall pressure ([`wall_state`]): the walls push back on the liquid their
+/// adhesion pulls on, as they do on its weight.
+pub(crate) fn adhesion(c: &Consts, fl: FluidSet, wl: WallSet, out: &mut [Vec3]) {
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, chunk)| {
+        for (o, a) in chunk.iter_mut().enumerate() {
+            let xi = fl.pos[ci * CHUNK + o];
+            let mut s = Vec3::ZERO;
+            wl.grid.for_each_run(xi, |run| {
+                for b in run {
+                    let dx = xi - wl.pos[b];
+                    let r2 = dx.length_squared();
+                    if r2 < c.r2max {
+                        s += adhesion_pair(c, &wl, b, dx, r2.sqrt());
+                    }
+                }
+            });
+            *a = s;
+        }
+    })
+}
+
+/// Wall state of every entry of `wl`: Adami et al. (2012) pressure
+/// `p_b = (Σ p_f W + (g − a_b)·Σ ρ_f x_bf W + Σ ρ_f (a_adh,f·x_bf) W)/Σ W`, `x_bf = x_b − x_f`
 /// (clamped at 0 so walls never pull fluid; adhesion is modelled separately), density from the inverse
 /// Tait law, and the dummy velocity `2 v_wall − ṽ` (no slip) or `ṽ` (free slip), ṽ the Shepard average
-/// of the fluid velocity. Also sets `wet` when a fluid particle is within the wet distance, and
-/// `wl.touched` (when not empty) for every real fluid particle within the cut-off of an entry.
+/// of the fluid velocity. `a_adh,f` is the adhesion acceleration of fluid particle f (`fl.adh`, empty
+/// without adhesion): Adami's extrapolation integrates the momentum balance `∇p = ρ (g − a_b)` from the
+/// fluid particle to the wall; an adhesive wall adds its own body force to that balance. Without it the
+/// wall pressure did not carry the adhesion's pull, the liquid next to the wall had to be compressed to
+/// carry it, the density diffusion drained that compression, and the contact line of 3D drops was pulled
+/// onto the wall surface (0–0.01 dp instead of dp/2) and broke up (docs/sph.md). Also sets `wet` when a
+/// fluid particle is within the wet distance, and `wl.touched` (when not empty) for every real fluid
+/// particle within the cut-off of an entry.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn wall_state(
     kernel: &Kernel,
@@ -309,6 +352,7 @@ pub(crate) fn wall_state(
                     let normal = wl.frames[part].rot * wl.ref_normal[wl.src[b] as usize];
                     let xs = xb + normal * c.wet_offset[part];
                     let (mut sw, mut spw, mut srx, mut svw) = (0.0, 0.0, Vec3::ZERO, Vec3::ZERO);
+                    let mut sad = 0.0;
                     let mut is_wet = false;
                     for (set, touched) in [(&fl, wl.touched), (&gh, &[][..])] {
                         // Neighbours collected without branching, then summed in the same order.
@@ -323,6 +367,9 @@ pub(crate) fn wall_state(
                                 sw += w;
                                 spw += c.eos.pressure(set.rho[j]) * w;
                                 srx += dx * (set.rho[j] * w);
+                                if !set.adh.is_empty() {
+                                    sad += set.adh[j].dot(dx) * set.rho[j] * w;
+                                }
                                 svw += set.vel[j] * w;
                                 let d = set.pos[j] - xs;
                                 let dn = d.dot(normal);
@@ -336,7 +383,7 @@ pub(crate) fn wall_state(
                     let (p, vv) = if sw > 0.0 {
                         let f = &wl.frames[wl.part[b] as usize];
                         let acc_b = f.acceleration(f.to_world(wl.ref_pos[wl.src[b] as usize]));
-                        let p = ((spw + (c.g - acc_b).dot(srx)) / sw).max(0.0);
+                        let p = ((spw + (c.g - acc_b).dot(srx) + sad) / sw).max(0.0);
                         let vt = svw / sw;
                         let vv = if c.slip_free[wl.part[b] as usize] { vt } else { 2.0 * wl.vel[b] - vt };
                         (p, vv)
@@ -381,11 +428,8 @@ fn wall_pair<K: KernelFn, const EXTRA: bool>(
     let mut acc = dx * (mb * s * f);
     let d = mb * vr * f;
     acc += (vi - wl.vvisc[b]) * (mb * c.nu * (irhoi + irhob) * r2 * f * inv_d);
-    if EXTRA && c.gamma_st > 0.0 && r > 0.0 {
-        let beta = c.beta[wl.part[b] as usize];
-        if beta != 0.0 {
-            acc -= dx * (beta * c.rho0 * wl.vol[b] * c.akinci.adhesion(r) / r);
-        }
+    if EXTRA && c.gamma_st > 0.0 {
+        acc += adhesion_pair(c, wl, b, dx, r);
     }
     (acc, d)
 }

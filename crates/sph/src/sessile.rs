@@ -57,6 +57,18 @@ pub struct SessileResult {
     pub residual_motion: f64,
     /// Particles removed during the run (the drop left the plate or broke up).
     pub removed: u64,
+    /// Height of the lowest particle's centre above the plate at the end \[m\]: dp/2 for liquid resting
+    /// on the wall as water filled against it does.
+    pub standoff: f64,
+}
+
+impl SessileResult {
+    /// The drop came to rest in one piece: no particle removed and a kinetic energy at the end below 0.1
+    /// of the surface-energy scale (settled drops end at 10⁻⁵–10⁻², a drop still spreading as a film at
+    /// about 10⁻²; unstable ones at 1–10). Only settled drops give a contact angle to calibrate with.
+    pub fn settled(&self) -> bool {
+        self.removed == 0 && self.residual_motion < 0.1
+    }
 }
 
 /// Runs the sessile drop and measures its contact angle.
@@ -70,11 +82,25 @@ pub fn sessile_drop(d: &SessileDrop) -> Result<SessileResult, SphError> {
     let mut p = SphParams::water(d.dim, dp, 10.0 * 3.0 * u);
     p.gravity = Vec3::ZERO;
     p.surface_tension = sigma;
+    // The cohesion compresses the liquid by its virial pressure and an adhesive wall the liquid near it
+    // by about the adhesion factor times that: the sound speed must keep both compressions small
+    // (c₀ ≥ 10 √(p/ρ)).
+    p.sound_speed = p.sound_speed.max(p.capillary_sound_speed(d.adhesion));
     // Viscous damping lets the drop come to rest within the run (the static angle does not depend on it).
     p.artificial_viscosity = 0.1;
     p.kinematic_viscosity = 1e-5;
     let mut sim = Simulation::new(p);
-    let half = 3.0 * r;
+    // Wide enough for the whole drop spread as a film: a wall of adhesion above about 1
+    // wets completely and the drop keeps spreading. On a narrower plate (3R until 2026-11-25) the film
+    // reached the edge and was drawn round it onto the plate's sides and underside, the cap height was
+    // measured from there, and the angle rose again with the factor (2D, R/8: 10.5° at 2, 37° at 5 and 10).
+    let film = match d.dim {
+        Dim::Two => std::f64::consts::PI * r * r / (4.0 * dp),
+        Dim::Three => (2.0 * r * r * r / (3.0 * dp)).sqrt(),
+    };
+    // The film is thinner than a spacing where the wall pulls it (measured in 3D at R/6, adhesion 2: base
+    // radius 5.9 mm against 4.0 mm for a film one spacing thick), so twice that extent.
+    let half = (3.0 * r).max(2.0 * film + 4.0 * dp);
     let three = d.dim == Dim::Three;
     let wall = Aabb::new(
         Vec3::new(-half, if three { -half } else { 0.0 }, -4.0 * dp),
@@ -104,7 +130,8 @@ pub fn sessile_drop(d: &SessileDrop) -> Result<SessileResult, SphError> {
     // wall by the compression transient.
     let rho_c = sim.params.eos().density(sim.params.cohesive_pressure());
     sim.fluid.rho.iter_mut().for_each(|r| *r = rho_c);
-    sim.set_domain(Aabb::new(Vec3::splat(-4.0 * r), Vec3::splat(4.0 * r)));
+    let reach = half + 4.0 * r;
+    sim.set_domain(Aabb::new(Vec3::splat(-reach), Vec3::splat(reach)));
     let tc = (rho * r * r * r / sigma).sqrt();
     sim.initialize()?;
     while sim.time < d.capillary_times * tc {
@@ -131,5 +158,75 @@ pub fn sessile_drop(d: &SessileDrop) -> Result<SessileResult, SphError> {
         height,
         residual_motion: sim.kinetic_energy() / energy_scale,
         removed: sim.removed.outside_domain + sim.removed.density_window,
+        standoff: zmin,
     })
+}
+
+/// Where a contact angle falls in a table of angles against adhesion factors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FactorFit {
+    /// The factor that gives the angle (interpolated linearly between the table's rows).
+    Within(f64),
+    /// The angle is larger than the table's largest: even the smallest factor wets more. Holds that
+    /// factor and its angle \[deg\].
+    LessWetting { factor: f64, angle_deg: f64 },
+    /// The angle is smaller than the table's smallest (complete wetting at this spacing): holds the
+    /// smallest factor that reaches the table's smallest angle, and that angle \[deg\].
+    MoreWetting { factor: f64, angle_deg: f64 },
+}
+
+/// The adhesion factor that gives contact angle `target_deg`, from `rows` of (factor, angle \[deg\]) with
+/// increasing factors (settled drops only, [`SessileResult::settled`]). The angle falls with the factor;
+/// where a measured angle rises again (noise of a drop that has spread to a film), the table is read
+/// through its running minimum, so the answer is the smallest factor that reaches the target.
+pub fn factor_for_angle(rows: &[(f64, f64)], target_deg: f64) -> Option<FactorFit> {
+    let first = *rows.first()?;
+    let mut env: Vec<(f64, f64)> = Vec::with_capacity(rows.len());
+    for &(f, a) in rows {
+        let a = env.last().map_or(a, |l: &(f64, f64)| a.min(l.1));
+        env.push((f, a));
+    }
+    if target_deg > first.1 {
+        return Some(FactorFit::LessWetting { factor: first.0, angle_deg: first.1 });
+    }
+    for w in env.windows(2) {
+        let ((f0, a0), (f1, a1)) = (w[0], w[1]);
+        if target_deg <= a0 && target_deg >= a1 && a0 > a1 {
+            return Some(FactorFit::Within(f0 + (f1 - f0) * (a0 - target_deg) / (a0 - a1)));
+        }
+    }
+    let smallest = env[env.len() - 1].1;
+    let f = env.iter().find(|r| r.1 == smallest).map_or(first.0, |r| r.0);
+    if target_deg == smallest {
+        Some(FactorFit::Within(f))
+    } else {
+        Some(FactorFit::MoreWetting { factor: f, angle_deg: smallest })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn factors_are_read_from_the_falling_angle() {
+        // The 2D table of docs/sph.md (R/8, 8 capillary times), with the film-limited rise at 10.
+        let rows = [(0.5, 100.1), (1.0, 20.5), (2.0, 6.7), (5.0, 5.3), (10.0, 5.5)]; // an earlier measurement
+        let Some(FactorFit::Within(f)) = factor_for_angle(&rows, 60.0) else { panic!("60° within") };
+        assert!((f - (0.5 + 0.5 * (100.1 - 60.0) / (100.1 - 20.5))).abs() < 1e-12);
+        let Some(FactorFit::Within(f)) = factor_for_angle(&rows, 100.1) else { panic!("end point") };
+        assert_eq!(f, 0.5);
+        assert_eq!(
+            factor_for_angle(&rows, 120.0),
+            Some(FactorFit::LessWetting { factor: 0.5, angle_deg: 100.1 })
+        );
+        // Below the smallest angle: the first factor that reached it (5, not 10).
+        assert_eq!(
+            factor_for_angle(&rows, 2.0),
+            Some(FactorFit::MoreWetting { factor: 5.0, angle_deg: 5.3 })
+        );
+        let Some(FactorFit::Within(f)) = factor_for_angle(&rows, 5.3) else { panic!("smallest angle") };
+        assert_eq!(f, 5.0);
+        assert_eq!(factor_for_angle(&[], 30.0), None);
+    }
 }

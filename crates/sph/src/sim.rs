@@ -122,6 +122,9 @@ struct Work {
     g_pr: Vec<f64>,
     g_irho: Vec<f64>,
     g_nrm: Vec<Vec3>,
+    /// Adhesion accelerations of the fluid and its periodic images (empty without adhesion).
+    adh: Vec<Vec3>,
+    g_adh: Vec<Vec3>,
     g_grid: NeighbourGrid,
     g_tmp_u: Vec<u32>,
     g_tmp_v: Vec<Vec3>,
@@ -667,6 +670,7 @@ impl Simulation {
             irho: &w.irho,
             c32: w.c32.view(),
             nrm: &[],
+            adh: &[],
             grid: &w.grid,
         };
         let gh = FluidSet {
@@ -677,6 +681,7 @@ impl Simulation {
             irho: &w.g_irho,
             c32: w.g_c32.view(),
             nrm: &[],
+            adh: &[],
             grid: &w.g_grid,
         };
         let wl = WallSet {
@@ -708,10 +713,23 @@ impl Simulation {
         w.w_touched.reset(self.fluid.len());
         let (mut rho, mut pr, mut irho) = (take(&mut w.w_rho), take(&mut w.w_pr), take(&mut w.w_irho));
         let (mut vvisc, mut wet) = (take(&mut w.w_vvisc), take(&mut w.w_wet));
+        let (mut adh, mut g_adh) = (take(&mut w.adh), take(&mut w.g_adh));
         let (fl, gh, wl) = self.views();
+        // The walls push back on the liquid their adhesion pulls on, like on its weight.
+        let adhesive = c.gamma_st > 0.0 && c.beta.iter().any(|&b| b != 0.0);
+        let (fl, gh) = if adhesive {
+            adh.resize(fl.pos.len(), Vec3::ZERO);
+            pass::adhesion(&c, fl, wl, &mut adh);
+            g_adh.clear();
+            g_adh.extend(self.work.g_src.iter().map(|&s| adh[s as usize]));
+            (FluidSet { adh: &adh, ..fl }, FluidSet { adh: &g_adh, ..gh })
+        } else {
+            (fl, gh)
+        };
         pass::wall_state(&kernel, &c, wl, fl, gh, &mut rho, &mut pr, &mut irho, &mut vvisc, &mut wet);
         let w = &mut self.work;
         (w.w_rho, w.w_pr, w.w_irho, w.w_vvisc, w.w_wet) = (rho, pr, irho, vvisc, wet);
+        (w.adh, w.g_adh) = (adh, g_adh);
     }
 
     /// Time step of the last step taken \[s\] (0 before the first).
@@ -1184,6 +1202,8 @@ impl Simulation {
             + b(&w.g_pr)
             + b(&w.g_irho)
             + b(&w.g_nrm)
+            + b(&w.adh)
+            + b(&w.g_adh)
             + b(&w.g_tmp_u)
             + b(&w.g_tmp_v)
             + w.g_c32.bytes()

@@ -555,7 +555,7 @@ pub fn sessile_drop_angles(quick: bool) -> Vec<Check> {
     let factors = [0.5, 0.75, 1.0];
     let mut angles = Vec::new();
     for &f in &factors {
-        // 2D: in 3D at these scales drops on walls of adhesion ≥ 1 are not yet stable (docs/sph.md §7).
+        // 2D for speed; the 3D drops are tested in tests/adhesion.rs.
         let mut d = SessileDrop::water(Dim::Two, f);
         if quick {
             d.resolution = 8;

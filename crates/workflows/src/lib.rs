@@ -7,3 +7,4 @@ pub mod dem_scene;
 pub mod deposition;
 pub mod snow;
 pub mod sph_scene;
+pub mod wading;

@@ -3,7 +3,7 @@
 use spatter_core::check::Checker;
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
 use spatter_io::run::{RunContext, RunDir, RunSummary};
-use spatter_workflows::sph_scene::{run, SphConfig};
+use spatter_workflows::sph_scene::{build, run, SphConfig};
 use std::path::Path;
 
 /// A small 2D dam break with a probe, a wall probe and height sensors.
@@ -489,4 +489,27 @@ fn wet_time_is_the_time_under_water() {
     }
     // 20 rows beside the water less the 3 that went below the floor; 3 rows reach the water line.
     assert_eq!((submerged, arriving), (17, 3));
+}
+
+/// A wall adhesion outside the calibrated range 0.75–3 is reported as a set-up warning (one per wall,
+/// naming it; the run writes it to the log), and a wall inside it is not; without surface tension adhesion
+/// has no effect and nothing is said.
+#[test]
+fn adhesion_outside_the_calibrated_range_is_warned_about() {
+    let with = |st: f64, f: f64| {
+        SMALL
+            .replace("spacing_m = 0.01", &format!("spacing_m = 0.01\nsurface_tension_n_m = {st}"))
+            .replace("max_m = [0.4, 0.0, 0.3]\n", &format!("max_m = [0.4, 0.0, 0.3]\nadhesion = {f}\n"))
+    };
+    for (st, f, warned) in [(0.072, 10.0, true), (0.072, 1.0, false), (0.0, 10.0, false)] {
+        let cfg = config(&with(st, f));
+        let (_, info) = build(&cfg, Path::new(".")).unwrap();
+        let line = "wall `tank`: adhesion 10 is above the calibrated range 0.75–3";
+        assert_eq!(
+            info.warnings.iter().any(|w| w.starts_with(line)),
+            warned,
+            "σ = {st}, adhesion {f}: {:?}",
+            info.warnings
+        );
+    }
 }

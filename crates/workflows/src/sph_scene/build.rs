@@ -19,6 +19,10 @@ pub struct BuildInfo {
     pub sound_speed: f64,
     pub fluid_particles: usize,
     pub wall_particles: usize,
+    /// Settings the log should warn about (adhesion outside the calibrated range, a sound speed below the
+    /// capillary limit).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 fn resolve(base: &Path, p: &Path) -> std::path::PathBuf {
@@ -196,7 +200,30 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
         Some(c) => c,
         None => f.sound_speed_factor * u_max,
     };
+    // With surface tension the liquid is also compressed by its cohesion and, near an adhesive wall, by
+    // the adhesion: c₀ ≥ 10 √(p/ρ₀) as well (`SphParams::capillary_sound_speed`).
+    let mut warnings = Vec::new();
+    let max_adhesion = cfg.walls.iter().map(|w| w.adhesion).fold(0.0, f64::max);
+    let c_cap = sim.params.capillary_sound_speed(max_adhesion);
+    let c0 = if f.sound_speed_m_s.is_none() && c_cap > c0 {
+        c_cap
+    } else {
+        if c_cap > c0 {
+            warnings.push(format!(
+                "fluid.sound_speed_m_s = {c0} m/s is below 10 √(p/ρ₀) = {c_cap:.4} m/s for the cohesive and adhesive \
+                 pressure: the liquid at adhesive walls is compressed by more than 1 %"
+            ));
+        }
+        c0
+    };
     sim.params.sound_speed = c0;
+    if f.surface_tension_n_m > 0.0 {
+        for w in &cfg.walls {
+            if let Some(note) = spatter_sph::params::SphParams::adhesion_note(w.adhesion) {
+                warnings.push(format!("wall `{}`: {note}", w.name));
+            }
+        }
+    }
 
     // Fluid.
     for (i, fc) in cfg.fill.iter().enumerate() {
@@ -242,6 +269,7 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
         sound_speed: c0,
         fluid_particles: sim.fluid.len(),
         wall_particles: sim.boundary.len(),
+        warnings,
     };
     Ok((sim, info))
 }

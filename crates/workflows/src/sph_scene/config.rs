@@ -308,6 +308,10 @@ pub struct OutputConfig {
     /// Also write wall particles once (`walls.vtu`).
     #[serde(default)]
     pub wall_particles: bool,
+    /// Top of the colour scale of the wetting PNGs (fraction of the time wet, in (0, 1]); default: the
+    /// largest value of each map. A fixed cap puts the maps of several runs on one scale.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wetting_cap: Option<f64>,
 }
 
 impl OutputConfig {
@@ -653,6 +657,9 @@ impl Validate for SphConfig {
             }
             if let Some(v) = o.vtu_interval_s {
                 c.positive("vtu_interval_s", v);
+            }
+            if let Some(v) = o.wetting_cap {
+                c.in_range("wetting_cap", v, 0.0, false, 1.0, true);
             }
             if let Some(v) = o.sample_interval_s {
                 c.positive("sample_interval_s", v);

@@ -179,6 +179,9 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
             sim.dt,
             rayon::current_num_threads()
         );
+        for w in &info.warnings {
+            tracing::warn!("{w}");
+        }
         let cols = series_columns(cfg, &sim);
         let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
         let series = CsvSeries::create(&series_path, &cols).map_err(io_at(&series_path))?;
@@ -356,14 +359,17 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
         let up = wcfg.and_then(|w| w.up).unwrap_or(du);
         let png = dir.path(&format!("wetting/{name}.png"));
         let (squares, fraction) = particle_map(&sim, k, elapsed);
-        spatter_io::plot::mesh_map_png(
+        let scale = match cfg.output.wetting_cap {
+            Some(cap) => (0.0, cap),
+            None => spatter_io::plot::auto_scale(&fraction),
+        };
+        spatter_io::plot::mesh_map_png_on_scale(
             &png,
             &squares,
             &fraction,
-            view,
-            up,
-            &format!("{name}: fraction of time wet (0–{elapsed:.3} s)"),
-            "time wet / elapsed",
+            (view, up),
+            (&format!("{name}: fraction of time wet (0–{elapsed:.3} s)"), "time wet / elapsed"),
+            scale,
         )
         .map_err(io_at(&png))?;
         summary.artifacts.push((format!("wetting map {name}"), png));

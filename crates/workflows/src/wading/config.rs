@@ -1,0 +1,185 @@
+//! The scenario file of kind `wading`: every key, its unit and default (documented in `docs/wading.md`).
+
+use super::channel::ChannelSpec;
+use super::vehicle::{PartFile, WheelSpec};
+use crate::sph_scene::config::{DragConfig, FluidConfig};
+use serde::{Deserialize, Serialize};
+use spatter_core::check::{Checker, Validate};
+use std::path::PathBuf;
+
+fn d_adhesion() -> f64 {
+    1.0
+}
+fn d_start_gap() -> f64 {
+    0.2
+}
+fn d_cap() -> f64 {
+    0.48
+}
+fn d_bin() -> f64 {
+    0.25
+}
+fn d_top() -> f64 {
+    12.0
+}
+fn d_drag() -> DragConfig {
+    DragConfig { enabled: true, ..DragConfig::default() }
+}
+
+/// The whole scenario (`kind = "wading"`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WadingConfig {
+    /// Free text shown in the log.
+    #[serde(default)]
+    pub title: String,
+    /// Water and numerics, as in the `sph` kind (`fluid.dimensions` must be 3).
+    pub fluid: FluidConfig,
+    /// Air drag on the water, as in the `sph` kind; on by default (air at rest).
+    #[serde(default = "d_drag")]
+    pub drag: DragConfig,
+    pub channel: ChannelSpec,
+    pub vehicle: VehicleConfig,
+    pub motion: MotionSpec,
+    /// Sensor patches: names of vehicle parts whose wet fraction is followed over time.
+    #[serde(default)]
+    pub sensors: Vec<String>,
+    #[serde(default)]
+    pub output: WadingOutput,
+}
+
+/// The vehicle: its part files, its wheels and the adhesion of its surfaces.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleConfig {
+    pub parts: Vec<PartFile>,
+    pub wheels: Vec<WheelSpec>,
+    /// Akinci adhesion factor of every vehicle part (needs `fluid.surface_tension_n_m` > 0). Default 1.
+    #[serde(default = "d_adhesion")]
+    pub adhesion: f64,
+    /// Gap between the front wheels' leading edge and the water's edge at the start \[m\]. Default 0.2.
+    #[serde(default = "d_start_gap")]
+    pub start_gap_m: f64,
+}
+
+/// How the vehicle moves along the channel: a constant speed or a speed table (exactly one).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// Constant speed along +x \[m/s\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_m_s: Option<f64>,
+    /// Speed table: rows `t_s speed_m_s`, linearly interpolated, held beyond the ends.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+}
+
+/// What is written and when the run ends.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WadingOutput {
+    /// End of the run \[s\]; default: when the front axle reaches the end of the pool floor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub end_time_s: Option<f64>,
+    /// Particle and wall snapshots (VTU + PVD) \[s\]; default end/40.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vtu_interval_s: Option<f64>,
+    /// Time-series rows \[s\]; default end/400.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_interval_s: Option<f64>,
+    /// Top of the colour scale of every wetting map (fraction of the time wet). Default 0.48.
+    #[serde(default = "d_cap")]
+    pub wetting_cap: f64,
+    /// Splash-height bin as a fraction of the water depth. Default 0.25.
+    #[serde(default = "d_bin")]
+    pub splash_bin_over_depth: f64,
+    /// Highest splash height recorded, in water depths above the pool floor. Default 12.
+    #[serde(default = "d_top")]
+    pub splash_top_over_depth: f64,
+}
+
+impl Default for WadingOutput {
+    fn default() -> Self {
+        WadingOutput {
+            end_time_s: None,
+            vtu_interval_s: None,
+            sample_interval_s: None,
+            wetting_cap: d_cap(),
+            splash_bin_over_depth: d_bin(),
+            splash_top_over_depth: d_top(),
+        }
+    }
+}
+
+impl Validate for WadingConfig {
+    fn validate(&self, c: &mut Checker) {
+        c.item("fluid", &self.fluid);
+        if self.fluid.dimensions != 3 {
+            c.nested("fluid", |c| {
+                c.fail(
+                    "dimensions",
+                    format!("dimensions = {} but a wading run is 3D: set 3", self.fluid.dimensions),
+                )
+            });
+        }
+        c.nested("drag", |c| {
+            c.positive("air_density_kg_m3", self.drag.air_density_kg_m3);
+            c.positive("air_viscosity_pa_s", self.drag.air_viscosity_pa_s);
+            c.finite_vec("air_velocity_m_s", self.drag.air_velocity_m_s);
+        });
+        c.item("channel", &self.channel);
+        c.nested("vehicle", |c| {
+            if self.vehicle.parts.is_empty() {
+                c.fail(
+                    "parts",
+                    "the vehicle needs at least one part file ([[vehicle.parts]] file = \"….stl\")",
+                );
+            }
+            for (i, p) in self.vehicle.parts.iter().enumerate() {
+                c.element("parts", i, |c| {
+                    c.file_exists("file", &p.file);
+                    c.positive("scale", p.scale);
+                });
+            }
+            if self.vehicle.wheels.is_empty() {
+                c.fail("wheels", "the vehicle needs wheels ([[vehicle.wheels]] part, axle_m, radius_m)");
+            }
+            c.non_negative("adhesion", self.vehicle.adhesion);
+            c.non_negative("start_gap_m", self.vehicle.start_gap_m);
+        });
+        c.nested("motion", |c| match (self.motion.speed_m_s, &self.motion.file) {
+            (Some(v), None) => c.positive("speed_m_s", v),
+            (None, Some(f)) => c.file_exists("file", f),
+            _ => c.fail(
+                "speed_m_s",
+                "give exactly one of speed_m_s (constant speed, m/s) and file (a table of `t_s speed_m_s` rows)",
+            ),
+        });
+        c.nested("output", |c| {
+            let o = &self.output;
+            if let Some(t) = o.end_time_s {
+                c.positive("end_time_s", t);
+            }
+            if let Some(t) = o.vtu_interval_s {
+                c.positive("vtu_interval_s", t);
+            }
+            if let Some(t) = o.sample_interval_s {
+                c.positive("sample_interval_s", t);
+            }
+            c.in_range("wetting_cap", o.wetting_cap, 0.0, false, 1.0, true);
+            c.positive("splash_bin_over_depth", o.splash_bin_over_depth);
+            c.positive("splash_top_over_depth", o.splash_top_over_depth);
+        });
+    }
+}
+
+impl spatter_io::run::Smoke for WadingConfig {
+    /// Spacing doubled (an eighth of the particles) and 20 ms of simulated time, two snapshots.
+    fn smoke(&mut self) {
+        self.fluid.spacing_m *= 2.0;
+        let end = self.output.end_time_s.unwrap_or(f64::INFINITY).min(0.02);
+        self.output.end_time_s = Some(end);
+        self.output.vtu_interval_s = Some(end / 2.0);
+        self.output.sample_interval_s = Some(end / 5.0);
+    }
+}

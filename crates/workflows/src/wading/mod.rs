@@ -1,0 +1,21 @@
+//! The wading workflow: a vehicle made of named parts drives through a wading channel (kind `wading`,
+//! `docs/wading.md`).
+//!
+//! The channel is generated from a few numbers with the still water's extent, wheels are placed on its
+//! road and the body's pitch follows the axle heights ([`channel`]); the vehicle's parts are read from
+//! multi-solid STL files ([`parts`]); wheels are found by part name and checked against their declared
+//! radius, the vehicle is checked against the channel's width and placed on the road ([`vehicle`]); the
+//! speed over time ([`timeline`]); the channel surfaces and the placed parts are written as STL
+//! ([`geometry`]); [`run`] turns all of it into an `sph` scene with motion tables (body pitch and travel,
+//! wheel spin ω = v/R), runs it and writes the wading reports.
+
+pub mod channel;
+pub mod config;
+pub mod geometry;
+pub mod parts;
+pub mod run;
+pub mod timeline;
+pub mod vehicle;
+
+pub use config::WadingConfig;
+pub use run::{run, WadingError};

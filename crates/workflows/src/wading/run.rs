@@ -1,0 +1,608 @@
+//! Running a `wading` scenario: the vehicle placed on the road and its motion tables, the `sph` scene
+//! they make (channel, pool, moving parts, splash-height sensors), then the wading reports (sensor
+//! series, wetting per group, the study's scalars).
+
+use super::channel::ChannelSpec;
+use super::config::WadingConfig;
+use super::geometry::{road_mesh, side_walls_mesh, write_stl};
+use super::parts::{bounds, read_parts, NamedPart};
+use super::timeline::SpeedProfile;
+use super::vehicle::{check_wheels, check_width, place_on_road, Placement, WheelSpec};
+use crate::sph_scene::config::{
+    DomainConfig, FillConfig, FillType, HeightConfig, MotionConfig, MotionType, OutputConfig, SensorConfig,
+    SphConfig, WallConfig, WallType,
+};
+use spatter_core::control::Finished;
+use spatter_core::Vec3;
+use spatter_io::run::{RunContext, RunSummary};
+use spatter_sph::boundary::Slip;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A wading run that cannot start or finish.
+#[derive(Debug, thiserror::Error)]
+pub enum WadingError {
+    /// A setting or file that does not fit, naming the scenario key.
+    #[error("{key}: {message}")]
+    Input { key: String, message: String },
+    #[error(transparent)]
+    Sph(#[from] spatter_sph::error::SphError),
+    #[error(transparent)]
+    Mesh(#[from] spatter_core::mesh::MeshError),
+    #[error("{0}")]
+    Io(String),
+}
+
+fn input(key: &str, message: impl Into<String>) -> WadingError {
+    WadingError::Input { key: key.into(), message: message.into() }
+}
+
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> WadingError + '_ {
+    move |e| WadingError::Io(format!("{}: {e}", path.display()))
+}
+
+/// The vehicle read and checked, with its motion along the channel.
+pub struct Plan {
+    pub parts: Vec<NamedPart>,
+    /// Report group of each part.
+    pub groups: Vec<String>,
+    pub speed: SpeedProfile,
+    /// Front axle's x at t = 0 \[m\].
+    pub x_front0: f64,
+    /// When the front wheels' leading edge reaches the still water \[s\].
+    pub t_enter: f64,
+    /// End of the run \[s\].
+    pub t_end: f64,
+    /// Largest front-wheel radius \[m\].
+    pub r_front: f64,
+}
+
+/// Reads the parts, checks the wheels and the width, and fixes the start and the end of the run.
+pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
+    let mut parts = Vec::new();
+    let mut groups = Vec::new();
+    for (i, pf) in cfg.vehicle.parts.iter().enumerate() {
+        let read = read_parts(&pf.file, pf.scale)
+            .map_err(|e| input(&format!("vehicle.parts[{i}].file"), e.to_string()))?;
+        for p in read {
+            if parts.iter().any(|q: &NamedPart| q.name == p.name) {
+                return Err(input(
+                    &format!("vehicle.parts[{i}].file"),
+                    format!("part `{}` is also in an earlier file; part names must be unique", p.name),
+                ));
+            }
+            groups.push(pf.group.clone().unwrap_or_else(|| p.name.clone()));
+            parts.push(p);
+        }
+    }
+    let errs = check_wheels(&parts, &cfg.vehicle.wheels);
+    if let Some(e) = errs.into_iter().next() {
+        return Err(input(&e.key, e.message));
+    }
+    for (k, w) in cfg.vehicle.wheels.iter().enumerate() {
+        let a = w.axis.normalize_or_zero();
+        if a.y.abs() < 0.999 {
+            return Err(input(
+                &format!("vehicle.wheels[{k}].axis"),
+                format!(
+                    "axis = [{}, {}, {}]: wheels roll about the y axis (across the channel)",
+                    w.axis.x, w.axis.y, w.axis.z
+                ),
+            ));
+        }
+    }
+    for (k, s) in cfg.sensors.iter().enumerate() {
+        if !parts.iter().any(|p| p.name == *s) {
+            let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+            return Err(input(
+                &format!("sensors[{k}]"),
+                format!("\"{s}\" names no vehicle part; the parts are: {}", names.join(", ")),
+            ));
+        }
+    }
+    if let Some(e) = check_width(&parts, &cfg.channel) {
+        return Err(input(&e.key, e.message));
+    }
+    let speed = match (&cfg.motion.speed_m_s, &cfg.motion.file) {
+        (Some(v), _) => SpeedProfile::constant(*v),
+        (None, Some(f)) => {
+            let text = std::fs::read_to_string(f)
+                .map_err(|e| input("motion.file", format!("{}: {e}", f.display())))?;
+            SpeedProfile::parse(&text, f).map_err(|e| input("motion.file", e))?
+        }
+        (None, None) => return Err(input("motion.speed_m_s", "give speed_m_s or file")),
+    };
+    let front = front_wheel(&cfg.vehicle.wheels);
+    let r_front = front.map(|w| w.radius_m).unwrap_or(0.0);
+    let (x_in, _) = cfg.channel.waterline();
+    let x_front0 = x_in - r_front - cfg.vehicle.start_gap_m;
+    let t_enter = speed.time_to(x_in - r_front - x_front0).unwrap_or(0.0);
+    let t_end = match cfg.output.end_time_s {
+        Some(t) => t,
+        None => speed.time_to(cfg.channel.pool_end_x() - x_front0).ok_or_else(|| {
+            input(
+                "motion.file",
+                "the speed table comes to rest before the front wheels reach the end of the pool; give \
+                 output.end_time_s or a table that keeps moving",
+            )
+        })?,
+    };
+    Ok(Plan { parts, groups, speed, x_front0, t_enter, t_end, r_front })
+}
+
+fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
+    wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x))
+}
+
+/// Rows `t vx vy vz wx wy wz` of the body's motion about its rear axle (the placement's pivot, in the
+/// world at t = 0), sampled every `dt` up to `t_end` and one step beyond: velocity and pitch rate by
+/// central differences of the placement on the road.
+fn body_table(plan: &Plan, place: &dyn Fn(f64) -> Placement, dt: f64) -> String {
+    let pose = |t: f64| {
+        let p = place(plan.x_front0 + plan.speed.distance(t));
+        (p.pivot + p.shift, p.pitch)
+    };
+    let n = (plan.t_end / dt).ceil() as usize + 1;
+    let eps = 1e-4 * dt;
+    let mut s = String::from("# t_s vx vy vz wx wy wz: the vehicle body about its rear axle\n");
+    for k in 0..=n {
+        let t = k as f64 * dt;
+        let (p1, a1) = pose(t + eps);
+        let (p0, a0) = pose((t - eps).max(0.0));
+        let h = t + eps - (t - eps).max(0.0);
+        let v = (p1 - p0) / h;
+        // Nose up (pitch growing) is a rotation about −y.
+        let wy = -(a1 - a0) / h;
+        let _ = writeln!(s, "{t} {} {} {} 0 {wy} 0", v.x, v.y, v.z);
+    }
+    s
+}
+
+/// Rows of a wheel's spin relative to the body: ω_y = v(t)/R (rolling without slip along +x).
+fn wheel_table(plan: &Plan, radius: f64, dt: f64) -> String {
+    let n = (plan.t_end / dt).ceil() as usize + 1;
+    let mut s = String::from("# t_s vx vy vz wx wy wz: wheel spin relative to the body, omega = v/R\n");
+    for k in 0..=n {
+        let t = k as f64 * dt;
+        let _ = writeln!(s, "{t} 0 0 0 0 {} 0", plan.speed.speed(t) / radius);
+    }
+    s
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), WadingError> {
+    if let Some(d) = path.parent() {
+        std::fs::create_dir_all(d).map_err(io_err(d))?;
+    }
+    std::fs::write(path, text).map_err(io_err(path))
+}
+
+/// The `sph` scene of the run, with its geometry and motion files written under `geo`.
+pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, WadingError> {
+    let c: &ChannelSpec = &cfg.channel;
+    let dp = cfg.fluid.spacing_m;
+    let wheels = &cfg.vehicle.wheels;
+    let place = |x_front: f64| place_on_road(&plan.parts, wheels, c, x_front);
+    let p0 = place(plan.x_front0);
+    let pivot0 = p0.pivot + p0.shift;
+    // Motion tables sampled every 2 cm of travel (at most 10 ms).
+    let dt = (0.02 / plan.speed.max_speed().max(1e-9)).min(0.01);
+    let body_file = geo.join("motion_body.txt");
+    write_text(&body_file, &body_table(plan, &place, dt))?;
+    let mut motions = vec![MotionConfig {
+        name: "body".into(),
+        parent: None,
+        kind: MotionType::Table,
+        velocity_m_s: None,
+        center_m: None,
+        axis: None,
+        angular_speed_rad_s: None,
+        file: Some(body_file),
+        reference_point_m: Some(pivot0),
+    }];
+    let mut walls = Vec::new();
+    let layers = Some((2.0 * cfg.fluid.h_over_dp.unwrap_or(1.5)).ceil() as usize);
+    for (name, mesh) in [("channel_road", road_mesh(c)), ("channel_walls", side_walls_mesh(c))] {
+        let file = geo.join(format!("{name}.stl"));
+        write_stl(&file, name, &mesh).map_err(io_err(&file))?;
+        walls.push(wall(name, file, None, c.adhesion, layers));
+    }
+    for part in &plan.parts {
+        let mut mesh = part.mesh.clone();
+        mesh.vertices.iter_mut().for_each(|v| *v = p0.apply(*v));
+        let file = geo.join(format!("{}.stl", part.name));
+        write_stl(&file, &part.name, &mesh).map_err(io_err(&file))?;
+        let motion = match wheels.iter().find(|w| w.part == part.name) {
+            Some(w) => {
+                let name = format!("spin_{}", part.name);
+                let f = geo.join(format!("motion_{}.txt", part.name));
+                write_text(&f, &wheel_table(plan, w.radius_m, dt))?;
+                motions.push(MotionConfig {
+                    name: name.clone(),
+                    parent: Some("body".into()),
+                    kind: MotionType::Table,
+                    velocity_m_s: None,
+                    center_m: None,
+                    axis: None,
+                    angular_speed_rad_s: None,
+                    file: Some(f),
+                    reference_point_m: Some(p0.apply(w.axle_m)),
+                });
+                name
+            }
+            None => "body".into(),
+        };
+        let mut w = wall(&part.name, file, Some(motion), cfg.vehicle.adhesion, None);
+        // A wheel's map is seen from outside the vehicle, looking at its outer face.
+        if let Some(spec) = wheels.iter().find(|w| w.part == part.name) {
+            let side = if p0.apply(spec.axle_m).y >= 0.0 { -1.0 } else { 1.0 };
+            w.view_dir = Some(Vec3::new(0.0, side, 0.0));
+            w.up = Some(Vec3::Z);
+        }
+        walls.push(w);
+    }
+    // The pool: a flood fill from its middle, centred across the channel for any width.
+    let (x_in, x_out) = c.waterline();
+    let n_across = (c.width_m / dp + 1e-9).floor();
+    let half = 0.5 * n_across * dp;
+    let floor = -c.pool_depth_m;
+    let fill = FillConfig {
+        kind: FillType::Flood,
+        min_m: Vec3::new(x_in - dp, -half, floor),
+        max_m: Vec3::new(x_out + dp, half, c.water_z()),
+        seed_m: Some(Vec3::new(0.5 * (x_in + x_out), 0.5 * dp, floor + 0.5 * c.water_depth_m)),
+        velocity_m_s: Vec3::ZERO,
+        hydrostatic: true,
+    };
+    // The box particles may not leave: the channel and the vehicle with room above for the splash.
+    let vb = bounds(&plan.parts);
+    let reach = (vb.max - vb.min).length();
+    let top = c.wall_height_m.max(floor + cfg.output.splash_top_over_depth * c.water_depth_m) + reach;
+    let domain = DomainConfig {
+        min_m: Some(Vec3::new((plan.x_front0 - reach).min(0.0) - 1.0, -0.5 * c.width_m - 1.0, floor - 1.0)),
+        max_m: Some(Vec3::new(c.length() + 1.0, 0.5 * c.width_m + 1.0, top)),
+        periodic: Vec::new(),
+    };
+    let x = c.water_depth_m;
+    let bin = cfg.output.splash_bin_over_depth * x;
+    let bins = (cfg.output.splash_top_over_depth / cfg.output.splash_bin_over_depth).ceil() as usize;
+    let t_end = plan.t_end;
+    Ok(SphConfig {
+        title: if cfg.title.is_empty() { "wading".into() } else { cfg.title.clone() },
+        fluid: cfg.fluid.clone(),
+        drag: cfg.drag.clone(),
+        domain,
+        motions,
+        walls,
+        fill: vec![fill],
+        output: OutputConfig {
+            end_time_s: t_end,
+            vtu_interval_s: Some(cfg.output.vtu_interval_s.unwrap_or(t_end / 40.0)),
+            sample_interval_s: Some(cfg.output.sample_interval_s.unwrap_or(t_end / 400.0)),
+            wall_particles: false,
+            wetting_cap: Some(cfg.output.wetting_cap),
+        },
+        sensors: SensorConfig {
+            wet_distance_m: None,
+            wet_lateral_m: None,
+            probes: Vec::new(),
+            wall_probes: Vec::new(),
+            height: Some(HeightConfig {
+                base_z_m: floor,
+                bin_m: bin,
+                bins,
+                window_s: [plan.t_enter.min(t_end), t_end],
+                reference_depth_m: Some(x),
+            }),
+        },
+    })
+}
+
+fn wall(
+    name: &str,
+    file: PathBuf,
+    motion: Option<String>,
+    adhesion: f64,
+    layers: Option<usize>,
+) -> WallConfig {
+    WallConfig {
+        name: name.into(),
+        kind: WallType::Mesh,
+        min_m: None,
+        max_m: None,
+        open_faces: None,
+        layers,
+        file: Some(file),
+        scale: 1.0,
+        center_m: None,
+        axis: None,
+        radius_m: None,
+        length_m: None,
+        segments: 48,
+        motion,
+        adhesion,
+        slip: Slip::default(),
+        wetting_map: true,
+        view_dir: None,
+        up: None,
+    }
+}
+
+/// Runs the scenario in `ctx`: see `docs/wading.md` for the files written.
+pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingError> {
+    let plan = plan(cfg)?;
+    let geo = ctx.dir.path("geometry");
+    let scfg = scene(cfg, &plan, &geo)?;
+    tracing::info!(
+        "wading: {} parts, front axle from x = {:.3} m, water reached at t = {:.3} s, end at t = {:.3} s (front axle at x = {:.3} m)",
+        plan.parts.len(),
+        plan.x_front0,
+        plan.t_enter,
+        plan.t_end,
+        plan.x_front0 + plan.speed.distance(plan.t_end)
+    );
+    let mut summary = crate::sph_scene::run_in(&scfg, ctx, &geo)?;
+    if summary.finished != Finished::Completed {
+        return Ok(summary);
+    }
+    report(cfg, &plan, ctx, &mut summary)?;
+    Ok(summary)
+}
+
+/// Sensor series, wetting per group and the study's scalars, from the files the scene wrote.
+fn report(
+    cfg: &WadingConfig,
+    plan: &Plan,
+    ctx: &RunContext,
+    summary: &mut RunSummary,
+) -> Result<(), WadingError> {
+    let dir = ctx.dir;
+    // Areas and mean wet fractions per wall from wetting.csv.
+    let wet_csv = dir.path("wetting.csv");
+    let text = std::fs::read_to_string(&wet_csv).map_err(io_err(&wet_csv))?;
+    let mut area: Vec<(String, f64, f64)> = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() >= 5 {
+            let a = f[1].trim().parse().unwrap_or(0.0);
+            let m = f[3].trim().parse().unwrap_or(0.0);
+            area.push((f[0].trim().to_owned(), a, m));
+        }
+    }
+    // Groups: area-weighted mean wet fraction.
+    let mut groups: Vec<(String, f64, f64)> = Vec::new();
+    for (part, group) in plan.parts.iter().zip(&plan.groups) {
+        let Some((_, a, m)) = area.iter().find(|(n, _, _)| *n == part.name) else { continue };
+        match groups.iter_mut().find(|g| g.0 == *group) {
+            Some(g) => {
+                g.1 += a;
+                g.2 += m;
+            }
+            None => groups.push((group.clone(), *a, *m)),
+        }
+    }
+    let rows: Vec<Vec<String>> = groups
+        .iter()
+        .map(|(g, a, m)| {
+            let f = if *a > 0.0 { m / a } else { 0.0 };
+            summary.scalar(&format!("group_{g}_mean_wet_fraction"), f);
+            vec![g.clone(), spatter_io::fmt_f64(*a), spatter_io::fmt_f64(*m), spatter_io::fmt_f64(f)]
+        })
+        .collect();
+    let gpath = dir.path("wetting_groups.csv");
+    spatter_io::csv::write_table(
+        &gpath,
+        &["group", "area_m2", "mean_wet_area_m2", "mean_wet_fraction"],
+        &rows,
+    )
+    .map_err(io_err(&gpath))?;
+    summary.artifacts.push(("wetting per group".into(), gpath));
+    // Sensor series: wet fraction over time from series.csv.
+    if !cfg.sensors.is_empty() {
+        let spath = dir.path("series.csv");
+        let text = std::fs::read_to_string(&spath).map_err(io_err(&spath))?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
+        let mut cols = Vec::new();
+        for (k, s) in cfg.sensors.iter().enumerate() {
+            let col = header.iter().position(|h| *h == format!("{s}_wet_area_m2"));
+            let a = area.iter().find(|(n, _, _)| n == s).map(|e| e.1);
+            if let (Some(c), Some(a)) = (col, a) {
+                cols.push((s.clone(), c, a.max(f64::MIN_POSITIVE)));
+            } else {
+                return Err(WadingError::Io(format!(
+                    "{}: no column {s}_wet_area_m2 for sensors[{k}] (or no area in wetting.csv)",
+                    spath.display()
+                )));
+            }
+        }
+        let mut rows = Vec::new();
+        let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); cols.len()];
+        for line in lines {
+            let f: Vec<&str> = line.split(',').collect();
+            let t: f64 = f.first().and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
+            let mut row = vec![spatter_io::fmt_f64(t)];
+            for (j, (_, c, a)) in cols.iter().enumerate() {
+                let w: f64 = f.get(*c).and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
+                row.push(spatter_io::fmt_f64(w / a));
+                curves[j].push((t, w / a));
+            }
+            rows.push(row);
+        }
+        let mut head = vec!["t_s".to_owned()];
+        head.extend(cols.iter().map(|(s, _, _)| format!("{s}_wet_fraction")));
+        let head: Vec<&str> = head.iter().map(String::as_str).collect();
+        let p = dir.path("sensors.csv");
+        spatter_io::csv::write_table(&p, &head, &rows).map_err(io_err(&p))?;
+        summary.artifacts.push(("sensor wet fractions".into(), p));
+        let mut chart =
+            spatter_io::plot::Chart::new("Sensor patches", "time [s]", "wet fraction of the patch");
+        for ((s, _, _), pts) in cols.iter().zip(&curves) {
+            chart = chart.line(s, pts);
+        }
+        let png = dir.path("sensors.png");
+        chart.save_png(&png).map_err(io_err(&png))?;
+        summary.artifacts.push(("sensor plot".into(), png));
+    }
+    // The study's scalars under the wading names.
+    let get = |n: &str| summary.scalars.iter().find(|(k, _)| k == n).map(|e| e.1);
+    if let Some(top) = get("splash_top_bin_height_over_depth") {
+        summary.scalar("max_splash_height_over_depth", top);
+    }
+    let vehicle: (f64, f64) = plan
+        .parts
+        .iter()
+        .filter_map(|p| area.iter().find(|(n, _, _)| *n == p.name))
+        .fold((0.0, 0.0), |acc, (_, a, m)| (acc.0 + a, acc.1 + m));
+    if vehicle.0 > 0.0 {
+        summary.scalar("vehicle_mean_wet_fraction", vehicle.1 / vehicle.0);
+    }
+    summary.headline.insert(
+        0,
+        format!(
+            "wading: front axle from x = {:.3} m to {:.3} m (pool end {:.3} m), water depth {} m",
+            plan.x_front0,
+            plan.x_front0 + plan.speed.distance(plan.t_end),
+            cfg.channel.pool_end_x(),
+            cfg.channel.water_depth_m
+        ),
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wading::config::{MotionSpec, WadingOutput};
+    use crate::wading::vehicle::PartFile;
+    use spatter_core::mesh::TriMesh;
+    use spatter_core::motion::{Motion, MotionTable};
+
+    fn wheel(centre: Vec3, r: f64) -> TriMesh {
+        let n = 24;
+        let mut soup = Vec::new();
+        for k in 0..n {
+            let a0 = k as f64 / n as f64 * std::f64::consts::TAU;
+            let a1 = (k + 1) as f64 / n as f64 * std::f64::consts::TAU;
+            let p = |a: f64, y: f64| centre + Vec3::new(r * a.cos(), y, r * a.sin());
+            soup.extend([p(a0, -0.1), p(a1, -0.1), p(a1, 0.1)]);
+            soup.extend([p(a0, -0.1), p(a1, 0.1), p(a0, 0.1)]);
+        }
+        TriMesh::from_triangle_soup(&soup)
+    }
+
+    /// A two-axle vehicle (wheels of radius 0.4 m, wheelbase 3 m) given 2 m above its road position, and
+    /// a channel 3 m wide with 0.3 m of water on a 0.5 m deep pool.
+    fn config(dir: &Path) -> WadingConfig {
+        let file = dir.join("car.stl");
+        let mut text = String::new();
+        for (name, x, y) in [("fl", 3.0, 0.8), ("fr", 3.0, -0.8), ("rl", 0.0, 0.8), ("rr", 0.0, -0.8)] {
+            let p = dir.join(format!("{name}.stl"));
+            write_stl(&p, name, &wheel(Vec3::new(x, y, 2.4), 0.4)).unwrap();
+            text.push_str(&std::fs::read_to_string(&p).unwrap());
+        }
+        std::fs::write(&file, text).unwrap();
+        let toml = format!(
+            r#"
+            sensors = ["fl"]
+            [fluid]
+            spacing_m = 0.05
+            [channel]
+            approach_length_m = 4.0
+            ramp_length_m = 2.0
+            pool_length_m = 5.0
+            pool_depth_m = 0.5
+            exit_length_m = 1.0
+            width_m = 3.0
+            wall_height_m = 0.8
+            water_depth_m = 0.3
+            [vehicle]
+            parts = [{{ file = "{}" }}]
+            wheels = [
+                {{ part = "fl", axle_m = [3.0, 0.8, 2.4], radius_m = 0.4 }},
+                {{ part = "fr", axle_m = [3.0, -0.8, 2.4], radius_m = 0.4 }},
+                {{ part = "rl", axle_m = [0.0, 0.8, 2.4], radius_m = 0.4 }},
+                {{ part = "rr", axle_m = [0.0, -0.8, 2.4], radius_m = 0.4 }},
+            ]
+            [motion]
+            speed_m_s = 2.0
+            "#,
+            file.display()
+        );
+        let cfg: WadingConfig = toml::from_str(&toml).unwrap();
+        assert_eq!(cfg.output, WadingOutput::default());
+        assert_eq!(cfg.vehicle.parts, vec![PartFile { file, scale: 1.0, group: None }]);
+        cfg
+    }
+
+    /// The body's motion table, integrated by the engine's kinematics, keeps both axles on the road
+    /// (axle height from the channel profile, `ChannelSpec::axle_z`) and the wheelbase at 3 m through the
+    /// entry ramp and across the pool, to 2 mm; the run starts with the front wheel 0.2 m before the water
+    /// and ends with the front axle at the end of the pool floor.
+    #[test]
+    fn the_motion_tables_keep_the_wheels_on_the_road() {
+        let dir = tempfile::tempdir().unwrap();
+        let cfg = config(dir.path());
+        let plan = plan(&cfg).unwrap();
+        let c = &cfg.channel;
+        let (x_in, _) = c.waterline();
+        assert!((plan.x_front0 - (x_in - 0.4 - 0.2)).abs() < 1e-12);
+        assert!((plan.t_enter - 0.1).abs() < 1e-9, "{}", plan.t_enter);
+        assert!((plan.x_front0 + 2.0 * plan.t_end - c.pool_end_x()).abs() < 1e-9);
+        let geo = dir.path().join("geometry");
+        let scene = scene(&cfg, &plan, &geo).unwrap();
+        let body = &scene.motions[0];
+        let text = std::fs::read_to_string(body.file.as_ref().unwrap()).unwrap();
+        let motion = Motion::Tabulated(MotionTable::parse(&text, body.reference_point_m.unwrap()).unwrap());
+        let p0 = place_on_road(&plan.parts, &cfg.vehicle.wheels, c, plan.x_front0);
+        let front0 = p0.apply(Vec3::new(3.0, 0.8, 2.4));
+        let rear0 = p0.apply(Vec3::new(0.0, 0.8, 2.4));
+        // At x = 4.2 the front wheel already rests on the entry ramp (it starts at x = 4).
+        assert!(
+            (front0.z - c.axle_z(4.2, 0.4)).abs() < 1e-6 && front0.z < 0.4,
+            "placed on the road: {front0}"
+        );
+        assert!((front0.y - 0.8).abs() < 1e-12, "centred across the channel: {front0}");
+        for k in 0..=20 {
+            let t = plan.t_end * k as f64 / 20.0;
+            let pose = motion.pose(t);
+            let (f, r) = (pose.apply(front0), pose.apply(rear0));
+            let x_f = plan.x_front0 + 2.0 * t;
+            assert!((f.x - x_f).abs() < 2e-3, "t = {t}: front axle at x = {} not {x_f}", f.x);
+            assert!((f.z - c.axle_z(f.x, 0.4)).abs() < 2e-3, "t = {t}: front axle {f} off the road");
+            assert!((r.z - c.axle_z(r.x, 0.4)).abs() < 2e-3, "t = {t}: rear axle {r} off the road");
+            assert!(((f - r).length() - 3.0).abs() < 2e-3, "t = {t}: wheelbase {}", (f - r).length());
+        }
+        // Wheels spin at v/R = 5 rad/s about +y relative to the body.
+        let spin = &scene.motions[1];
+        let text = std::fs::read_to_string(spin.file.as_ref().unwrap()).unwrap();
+        let table = MotionTable::parse(&text, spin.reference_point_m.unwrap()).unwrap();
+        assert_eq!(table.rates(0.3), (Vec3::ZERO, Vec3::new(0.0, 5.0, 0.0)));
+        // The pool is centred across the channel and reaches the waterline; splash heights from the floor.
+        let fill = &scene.fill[0];
+        assert!((fill.min_m.y + fill.max_m.y).abs() < 1e-12 && fill.max_m.z == c.water_z());
+        let h = scene.sensors.height.as_ref().unwrap();
+        assert_eq!((h.base_z_m, h.reference_depth_m), (-0.5, Some(0.3)));
+        assert!((h.bin_m - 0.075).abs() < 1e-12 && h.bins == 48);
+    }
+
+    #[test]
+    fn unknown_sensors_and_stalling_tables_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = config(dir.path());
+        cfg.sensors = vec!["fl".into(), "mirror".into()];
+        let e = plan(&cfg).err().unwrap().to_string();
+        assert!(
+            e.starts_with("sensors[1]: \"mirror\" names no vehicle part; the parts are: fl, fr, rl, rr"),
+            "{e}"
+        );
+        cfg.sensors.clear();
+        let table = dir.path().join("v.txt");
+        std::fs::write(&table, "0 2\n1 0\n").unwrap();
+        cfg.motion = MotionSpec { speed_m_s: None, file: Some(table) };
+        let e = plan(&cfg).err().unwrap().to_string();
+        assert!(e.starts_with("motion.file: the speed table comes to rest"), "{e}");
+        cfg.vehicle.wheels[0].part = "front".into();
+        let e = plan(&cfg).err().unwrap().to_string();
+        assert!(e.starts_with("vehicle.wheels[0].part: part = \"front\" names no part"), "{e}");
+    }
+}

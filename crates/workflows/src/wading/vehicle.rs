@@ -1,0 +1,280 @@
+//! The vehicle: its part files, its wheels (found by part name, with axle and radius), checks that name
+//! the scenario key of every problem, and its placement on the channel's road.
+
+use super::channel::{pitch, ChannelSpec};
+use super::parts::{bounds, wheel_reach, NamedPart};
+use serde::{Deserialize, Serialize};
+use spatter_core::check::Invalid;
+use spatter_core::Vec3;
+use std::path::PathBuf;
+
+fn one() -> f64 {
+    1.0
+}
+
+fn axis_y() -> Vec3 {
+    Vec3::Y
+}
+
+/// A mesh file of the vehicle; its solids become parts ([`super::parts::read_parts`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartFile {
+    pub file: PathBuf,
+    /// Coordinate factor (0.001 for files in mm). Default 1.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Report group of the file's parts (cab, chassis, wheels, sensors, …). Default: the part's name.
+    #[serde(default)]
+    pub group: Option<String>,
+}
+
+/// A wheel: a part that rolls about its axle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WheelSpec {
+    /// Name of the part (a solid of one of the files).
+    pub part: String,
+    /// A point of the axle in the files' coordinates (after `scale`) \[m\].
+    pub axle_m: Vec3,
+    /// Rolling radius \[m\]; the wheel turns at ω = v/R.
+    pub radius_m: f64,
+    /// Axle direction. Default `[0, 1, 0]` (across the channel).
+    #[serde(default = "axis_y")]
+    pub axis: Vec3,
+}
+
+/// Relative mismatch allowed between a wheel's declared radius and its mesh's reach from the axle.
+pub const RADIUS_TOLERANCE: f64 = 0.02;
+
+/// Every problem of the wheels against the parts read: a wheel whose part does not exist (the message
+/// lists the parts), and a wheel whose mesh does not reach its declared radius from its axle (it would
+/// not touch the road, or would sink into it), each under the key `vehicle.wheels[k]…`.
+pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
+    let mut errs = Vec::new();
+    let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+    for (k, w) in wheels.iter().enumerate() {
+        let key = |field: &str| format!("vehicle.wheels[{k}].{field}");
+        let Some(part) = parts.iter().find(|p| p.name == w.part) else {
+            errs.push(Invalid {
+                key: key("part"),
+                message: format!("part = \"{}\" names no part; the parts are: {}", w.part, names.join(", ")),
+            });
+            continue;
+        };
+        if !(w.radius_m > 0.0 && w.radius_m.is_finite()) {
+            errs.push(Invalid {
+                key: key("radius_m"),
+                message: format!("radius_m = {} must be > 0", w.radius_m),
+            });
+            continue;
+        }
+        let axis = w.axis.normalize_or_zero();
+        if axis == Vec3::ZERO {
+            errs.push(Invalid { key: key("axis"), message: "axis = [0, 0, 0] has no direction".into() });
+            continue;
+        }
+        let reach = wheel_reach(&part.mesh, w.axle_m, axis);
+        if (reach - w.radius_m).abs() > RADIUS_TOLERANCE * w.radius_m {
+            errs.push(Invalid {
+                key: key("radius_m"),
+                message: format!(
+                    "radius_m = {} m, but the mesh of part `{}` reaches {reach:.4} m from the axle at [{}, {}, {}]: \
+                     placed by its radius the wheel would {} the road; give the axle and radius of the mesh \
+                     (within {} %)",
+                    w.radius_m,
+                    w.part,
+                    w.axle_m.x,
+                    w.axle_m.y,
+                    w.axle_m.z,
+                    if reach < w.radius_m { "not touch" } else { "sink into" },
+                    RADIUS_TOLERANCE * 100.0
+                ),
+            });
+        }
+    }
+    errs
+}
+
+/// A vehicle as wide as the channel or wider, named under `channel.width_m`.
+pub fn check_width(parts: &[NamedPart], channel: &ChannelSpec) -> Option<Invalid> {
+    let b = bounds(parts);
+    let across = b.max.y - b.min.y;
+    (across >= channel.width_m).then(|| Invalid {
+        key: "channel.width_m".into(),
+        message: format!(
+            "width_m = {} m is not wider than the vehicle ({across:.3} m across its parts): it would not fit between \
+             the walls",
+            channel.width_m
+        ),
+    })
+}
+
+/// Rigid placement of the vehicle on the road: rotate by `pitch` \[rad\] (nose up positive) about the
+/// rear axle, then translate by `shift` \[m\].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub pitch: f64,
+    pub pivot: Vec3,
+    pub shift: Vec3,
+}
+
+impl Placement {
+    /// World position of a point given in the files' coordinates.
+    pub fn apply(&self, x: Vec3) -> Vec3 {
+        let d = x - self.pivot;
+        // Nose up for travel along +x: a rotation by −pitch about +y.
+        let (s, c) = (-self.pitch).sin_cos();
+        let r = Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+        self.pivot + r + self.shift
+    }
+}
+
+/// Places the vehicle so that its front axle (the wheels' largest axle x) is at `x_front` along the
+/// channel, centred across it (y of the parts' bounds' middle at 0), with every wheel on the road: the
+/// front and rear axle heights from [`ChannelSpec::axle_z`], the rear axle where the road puts it at the
+/// axle-to-axle distance behind the front one, and the pitch from the two. `wheels` must have passed
+/// [`check_wheels`].
+pub fn place_on_road(
+    parts: &[NamedPart],
+    wheels: &[WheelSpec],
+    channel: &ChannelSpec,
+    x_front: f64,
+) -> Placement {
+    let front = wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
+    let rear = wheels.iter().min_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
+    let (Some(front), Some(rear)) = (front, rear) else {
+        return Placement { pitch: 0.0, pivot: Vec3::ZERO, shift: Vec3::ZERO };
+    };
+    let b = bounds(parts);
+    let y_mid = 0.5 * (b.min.y + b.max.y);
+    // Axle-to-axle distance in the x–z plane; the rear axle sits on the road at that distance behind the
+    // front one (bisection: the distance grows as the rear axle moves back).
+    let span = ((front.axle_m.x - rear.axle_m.x).powi(2) + (front.axle_m.z - rear.axle_m.z).powi(2)).sqrt();
+    let zf = channel.axle_z(x_front, front.radius_m);
+    let dist = |xr: f64| ((x_front - xr).powi(2) + (zf - channel.axle_z(xr, rear.radius_m)).powi(2)).sqrt();
+    let (mut lo, mut hi) = (x_front - span - 1.0, x_front);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if dist(mid) > span {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let x_rear = 0.5 * (lo + hi);
+    let zr = channel.axle_z(x_rear, rear.radius_m);
+    let th = pitch((x_front, zf), (x_rear, zr))
+        - pitch((front.axle_m.x, front.axle_m.z), (rear.axle_m.x, rear.axle_m.z));
+    Placement {
+        pitch: th,
+        pivot: rear.axle_m,
+        shift: Vec3::new(x_rear - rear.axle_m.x, -y_mid, zr - rear.axle_m.z),
+    }
+}
+
+/// Angular speed \[rad/s\] about +axis of a wheel of radius `r` rolling without slip at speed `v` along
+/// +x with its axle along +y: ω = v/R (the contact point `v e_x + ω e_y × (−R e_z)` is at rest).
+pub fn rolling_speed(v: f64, r: f64) -> f64 {
+    v / r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spatter_core::mesh::TriMesh;
+
+    fn wheel_mesh(centre: Vec3, r: f64) -> TriMesh {
+        let n = 32;
+        let mut soup = Vec::new();
+        for k in 0..n {
+            let a0 = k as f64 / n as f64 * std::f64::consts::TAU;
+            let a1 = (k + 1) as f64 / n as f64 * std::f64::consts::TAU;
+            let p = |a: f64, y: f64| centre + Vec3::new(r * a.cos(), y, r * a.sin());
+            soup.extend([p(a0, -0.15), p(a1, -0.15), p(a1, 0.15)]);
+            soup.extend([p(a0, -0.15), p(a1, 0.15), p(a0, 0.15)]);
+        }
+        TriMesh::from_triangle_soup(&soup)
+    }
+
+    fn truck() -> (Vec<NamedPart>, Vec<WheelSpec>) {
+        let mut parts = Vec::new();
+        let mut wheels = Vec::new();
+        for (name, x, y) in
+            [("wheel_fl", 4.0, 1.0), ("wheel_fr", 4.0, -1.0), ("wheel_rl", 0.0, 1.0), ("wheel_rr", 0.0, -1.0)]
+        {
+            let c = Vec3::new(x, y, 0.5);
+            parts.push(NamedPart { name: name.into(), mesh: wheel_mesh(c, 0.5) });
+            wheels.push(WheelSpec { part: name.into(), axle_m: c, radius_m: 0.5, axis: Vec3::Y });
+        }
+        (parts, wheels)
+    }
+
+    fn channel() -> ChannelSpec {
+        ChannelSpec {
+            approach_length_m: 8.0,
+            ramp_length_m: 3.0,
+            pool_length_m: 10.0,
+            pool_depth_m: 0.5,
+            exit_length_m: 2.0,
+            width_m: 4.0,
+            wall_height_m: 1.0,
+            water_depth_m: 0.3,
+            adhesion: 1.0,
+        }
+    }
+
+    #[test]
+    fn wheels_are_checked_by_name_and_radius() {
+        let (parts, mut wheels) = truck();
+        assert!(check_wheels(&parts, &wheels).is_empty());
+        wheels[1].part = "wheel_xx".into();
+        wheels[2].radius_m = 0.6;
+        let errs = check_wheels(&parts, &wheels);
+        assert_eq!(errs.len(), 2, "{errs:?}");
+        assert_eq!(errs[0].key, "vehicle.wheels[1].part");
+        assert!(
+            errs[0].message.contains("\"wheel_xx\" names no part; the parts are: wheel_fl, wheel_fr"),
+            "{}",
+            errs[0].message
+        );
+        assert_eq!(errs[1].key, "vehicle.wheels[2].radius_m");
+        assert!(errs[1].message.contains("would not touch the road"), "{}", errs[1].message);
+    }
+
+    #[test]
+    fn a_vehicle_wider_than_the_channel_is_named() {
+        let (parts, _) = truck();
+        let mut c = channel();
+        assert!(check_width(&parts, &c).is_none());
+        c.width_m = 2.2;
+        let e = check_width(&parts, &c).unwrap();
+        assert_eq!(e.key, "channel.width_m");
+        assert!(e.message.contains("2.300 m across"), "{}", e.message);
+    }
+
+    /// On the flat approach the truck stands level with its axles at R; with the front axle on the entry
+    /// ramp it pitches nose down and both wheels touch the road (axle heights from the channel's profile).
+    #[test]
+    fn the_vehicle_stands_on_the_road() {
+        let (parts, wheels) = truck();
+        let c = channel();
+        let p = place_on_road(&parts, &wheels, &c, 6.0);
+        assert!(p.pitch.abs() < 1e-12);
+        let f = p.apply(wheels[0].axle_m);
+        assert!((f - Vec3::new(6.0, 1.0, 0.5)).length() < 1e-12, "{f}");
+        for x_front in [9.5, 11.0, 13.0, 20.0, 23.5] {
+            let p = place_on_road(&parts, &wheels, &c, x_front);
+            let f = p.apply(wheels[0].axle_m);
+            let r = p.apply(wheels[2].axle_m);
+            assert!((f.x - x_front).abs() < 1e-9, "front axle at {} not {x_front}", f.x);
+            assert!(((f - r).length() - 4.0).abs() < 1e-9, "wheelbase kept");
+            assert!((f.z - c.axle_z(f.x, 0.5)).abs() < 1e-6, "front wheel on the road at {x_front}: {f}");
+            assert!((r.z - c.axle_z(r.x, 0.5)).abs() < 1e-6, "rear wheel on the road at {x_front}: {r}");
+            if x_front == 9.5 {
+                assert!(p.pitch < -0.05, "nose down on the entry ramp: {}", p.pitch);
+            }
+        }
+        assert!((rolling_speed(3.0, 0.5) - 6.0).abs() < 1e-15);
+    }
+}
