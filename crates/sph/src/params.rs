@@ -9,7 +9,7 @@ use spatter_core::Vec3;
 /// [`SphParams::adhesion_note`] and docs/sph.md, "Sessile-drop calibration").
 pub const ADHESION_CALIBRATED: [f64; 2] = [0.75, 3.0];
 
-/// Air drag on fluid particles (no equation in the thesis, digest §2.12; model choice in [`crate::drag`]).
+/// Air drag on fluid particles (the wading thesis gives no equation; model choice in [`crate::drag`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DragParams {
     pub enabled: bool,
@@ -142,7 +142,7 @@ impl SphParams {
     /// Akinci adhesion β per unit of a wall's `adhesion` factor: β = factor · γ · M_C/M_A with
     /// `M_X = ∫₀^R r^d X(r) dr` (d the dimension). A wall of factor 1 then pulls on the fluid near it (in the
     /// virial sense) as strongly as the fluid pulls on itself — the parameterisation of the thesis's
-    /// Preonlab runs ("adhesion factor × cohesion", digest §2.10.3): 1 wets like the liquid itself, 0 does not
+    /// Preonlab runs ("adhesion factor × cohesion", Arjun & Michael 2022): 1 wets like the liquid itself, 0 does not
     /// attract at all, and the sessile-drop utility maps factors to contact angles.
     pub fn adhesion_per_factor(&self) -> f64 {
         let gamma = self.cohesion_coefficient();

@@ -1,6 +1,6 @@
 //! Sessile-drop calibration: the static contact angle that a given Akinci adhesion coefficient produces,
-//! so users can choose the adhesion of a wall from a measured contact angle (digest §2.10.5, future-work
-//! item L1428).
+//! so users can choose the adhesion of a wall from a measured contact angle (the calibration the truck wading
+//! thesis, Arjun & Michael 2022, lists as future work).
 //!
 //! A half-disc (2D) or hemisphere (3D) of water is placed on a flat wall without gravity and relaxes
 //! under surface tension and adhesion until it is at rest. The angle is read from the spherical-cap

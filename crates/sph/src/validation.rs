@@ -1,4 +1,5 @@
-//! Reference cases of `spatter validate` (VERIFICATION.md, SPH section). Each runs a reduced variant in
+//! Reference cases of `spatter validate` (hydrostatic tank, Poiseuille flow after Morris, Fox & Zhu
+//! 1997, dam break against Martin & Moyce 1952). Each runs a reduced variant in
 //! seconds (`quick = true`, also run by the crate's tests) and a finer one for the report.
 
 use crate::boundary::Slip;
@@ -199,7 +200,7 @@ pub fn submerged_solid(quick: bool) -> Vec<Check> {
 }
 
 /// Water at rest in a tank: pressure at depth within 2 % of ρgz after settling, no particle lost,
-/// kinetic energy decaying (VERIFICATION.md). 2D; the full variant is finer and 3D.
+/// kinetic energy decaying. 2D; the full variant is finer and 3D.
 pub fn hydrostatic_tank(quick: bool) -> Vec<Check> {
     let case = "sph_hydrostatic_tank";
     let (dim, dp, t_end) = if quick { (Dim::Two, 0.01, 1.0) } else { (Dim::Three, 0.01, 1.5) };

@@ -1,7 +1,6 @@
 //! A helicopter rotor downwash model: momentum theory, ground effect and analytic tip vortices.
 //!
-//! Sources: Jasion (2013) eq. 4.13, 4.26–4.27, 6.1–6.3, 6.11–6.14 (`digests/seed_003_brownout.md` §4.3,
-//! §4.5, §4.6, §6.4).
+//! Sources: Jasion (2013) eq. 4.13, 4.26–4.27, 6.1–6.3, 6.11–6.14.
 //!
 //! **Mean flow.** The rotor (axis +z, hub at `hub_m`, ground plane z = `ground_z_m`) has induced velocity
 //! v_ind = √(T/(2ρA)) (momentum theory). The free wake is the classical actuator-disk slipstream: on the
@@ -427,7 +426,7 @@ mod tests {
 
     #[test]
     fn momentum_theory_and_ground_effect_values() {
-        // digests/seed_003_brownout.md §6.4 item 1 ([R]): v_ind = 6.06 m/s, ṁ = 725.9 kg/s.
+        // Momentum theory for the Bell 47 of Jasion (2013) (W = 8.8 kN, R = 5.66 m, ρ = 1.19): v_ind = 6.06 m/s, ṁ = 725.9 kg/s.
         assert!((induced_velocity(8800.0, 1.19, 5.66) - 6.06).abs() < 0.005);
         assert!((mass_flow(8800.0, 1.19, 5.66) - 725.9).abs() < 0.5);
         // §6.4 item 2 ([D]), 4 decimals: z_d/R = 0.5, 0.68, 1.5, 4.
