@@ -23,10 +23,10 @@ use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
 use spatter_io::run::{RunContext, RunSummary};
 
-/// Everything a resumed run needs.
+/// Everything a resumed run needs (the checkpoint header names the input it belongs to: a resume with
+/// another scene is refused when it is loaded).
 #[derive(Serialize, Deserialize)]
 struct Checkpoint<S> {
-    scene_hash: u64,
     sim: SimState<S>,
     /// State of each injector (particles and mass placed, pending draw, random generator).
     injectors: Vec<InjectorState>,
@@ -144,17 +144,6 @@ pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> 
             ctx,
         ),
     }
-}
-
-/// FNV-1a hash of the scene's JSON form: a checkpoint is only resumed with the scene that wrote it.
-fn scene_hash(cfg: &SceneConfig) -> u64 {
-    let text = serde_json::to_string(cfg).unwrap_or_default();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 struct Outputs {
@@ -296,7 +285,6 @@ fn run_with<L: ContactLaw>(
     let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
     let inject_every: Vec<u64> =
         cfg.inject.iter().map(|j| ((j.interval_s / cfg.dt_s).round() as u64).max(1)).collect();
-    let hash = scene_hash(cfg);
     let dir = ctx.dir;
     let csv_path = dir.path("energy.csv");
     let pvd_path = dir.path("particles.pvd");
@@ -318,12 +306,6 @@ fn run_with<L: ContactLaw>(
     let mut out;
     if ctx.resume {
         let ck: Checkpoint<L::State> = ctx.load_checkpoint()?;
-        if ck.scene_hash != hash {
-            return Err(DemError::Resume(format!(
-                "{} was written by a different scene; run without resume to start afresh",
-                dir.checkpoint_path().display()
-            )));
-        }
         sim.restore(ck.sim).map_err(DemError::Resume)?;
         if ck.injectors.len() != injectors.len() {
             return Err(DemError::Resume("the number of injectors changed".into()));
@@ -413,7 +395,6 @@ fn run_with<L: ContactLaw>(
         if stop || ctx.checkpoint_due() {
             out.flush()?;
             let ck = Checkpoint {
-                scene_hash: hash,
                 sim: sim.state(),
                 injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
                 output_index: out.index,

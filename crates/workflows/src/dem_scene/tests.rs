@@ -131,6 +131,25 @@ fn interrupted_and_resumed_run_equals_uninterrupted_run_bit_for_bit() {
 }
 
 #[test]
+fn resuming_with_another_scene_is_refused_by_the_checkpoint_header() {
+    // The job driver stamps checkpoints with the resolved input's hash; the DEM run loads its checkpoint
+    // through the context, so another scene's hash is refused (here 21 and 22 stand for two inputs).
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = parse(&pour_toml(&floor_stl(tmp.path())));
+    let dir = RunDir::create(&tmp.path().join("run")).unwrap();
+    let stop = StopAfterPolls::new(50);
+    let first = RunContext { input_hash: 21, ..RunContext::new(&dir, &stop, false) };
+    assert_eq!(run(&cfg, &first).unwrap().finished, Finished::Interrupted);
+    let mut other = cfg.clone();
+    other.duration_s *= 2.0;
+    let e = run(&other, &RunContext { input_hash: 22, ..RunContext::new(&dir, &Unattended, true) })
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("different scenario"), "{e}");
+    assert!(dir.checkpoint_path().is_file(), "the checkpoint is kept for its own scene");
+}
+
+#[test]
 fn validation_names_the_bad_keys() {
     let tmp = tempfile::tempdir().unwrap();
     let mut cfg = parse(&pour_toml(&floor_stl(tmp.path())));
