@@ -161,10 +161,11 @@ pub fn pitch(front: (f64, f64), rear: (f64, f64)) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn channel() -> ChannelSpec {
+    /// A channel with every dimension set, shared by the wading tests.
+    pub(crate) fn channel() -> ChannelSpec {
         ChannelSpec {
             approach_length_m: 4.0,
             ramp_length_m: 3.0,

@@ -73,20 +73,7 @@ pub fn write_stl(path: &Path, name: &str, mesh: &TriMesh) -> std::io::Result<()>
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn channel() -> ChannelSpec {
-        ChannelSpec {
-            approach_length_m: 4.0,
-            ramp_length_m: 3.0,
-            pool_length_m: 6.0,
-            pool_depth_m: 0.5,
-            exit_length_m: 2.0,
-            width_m: 4.0,
-            wall_height_m: 1.0,
-            water_depth_m: 0.3,
-            adhesion: 1.0,
-        }
-    }
+    use crate::wading::channel::tests::channel;
 
     /// The road's area is the width times the profile's length; its normals point up; the walls' normals
     /// point into the channel and their area is twice ∫ (top − road) dx.
