@@ -454,51 +454,60 @@ impl<L: ContactLaw> Simulation<L> {
             acc = Acc::combine(acc, a);
         }
 
-        // Mesh impact records and wear (sequential: slots of different particles share triangles).
+        // Mesh impact records and wear (sequential: slots of different particles share triangles). The loop
+        // runs over the wall slots in order (particle by particle, as the CSR list stores them); the
+        // particle owning a slot is looked up only for a slot that records something, so a scene of
+        // analytic walls without an event log pays one flag test per slot and nothing per particle.
         let wl = &self.st.wall_list;
         let p = &self.particles;
         let bodies = &self.st.bodies;
         self.impacts.clear();
-        for i in 0..p.len() {
-            for k in wl.start[i] as usize..wl.start[i + 1] as usize {
-                let o = wl.out[k];
-                if !o.active {
-                    continue;
-                }
-                if self.record_impacts && o.formed {
-                    let w = wl.wall[k] as usize;
-                    let wall = &self.walls[w];
-                    let (normal, v_wall) =
-                        super::impacts::contact_frame(wall, &self.scratch.kin[w], wl.tri[k], p.pos[i]);
-                    self.impacts.push(super::WallImpact {
-                        particle: p.id[i],
-                        body: p.is_member(i).then(|| bodies.id[p.body[i] as usize]),
-                        wall: w,
-                        triangle: matches!(wall.shape, WallShape::Mesh(_)).then_some(wl.tri[k]),
-                        time: self.st.time,
-                        normal,
-                        velocity: p.vel[i] - v_wall,
-                    });
-                }
-                let wall = &mut self.walls[wl.wall[k] as usize];
-                let wall_material = wall.material as usize;
-                if let WallShape::Mesh(m) = &mut wall.shape {
-                    let t = wl.tri[k] as usize;
-                    let r = &mut m.records;
-                    let ft = (o.force.length_squared() - o.normal_force * o.normal_force).max(0.0).sqrt();
-                    r.normal_impulse[t] += o.normal_force.abs() * dt;
-                    r.tangential_impulse[t] += ft * dt;
-                    if o.formed {
-                        let v_n = o.approach_speed.max(0.0);
-                        r.impacts[t] += 1;
-                        r.impact_speed_sum[t] += o.approach_speed;
-                        r.impact_angle_sum[t] += v_n.atan2(o.tangential_speed).to_degrees();
-                        if let Some(model) = self.wear.get(p.material[i] as usize, wall_material) {
-                            // The impacting mass: the whole body for a clump member.
-                            let mass =
-                                if p.is_member(i) { bodies.mass(p.body[i] as usize) } else { p.mass(i) };
-                            r.eroded_mass[t] += model.eroded_mass(mass, v_n, o.tangential_speed);
-                        }
+        let mut i = 0usize;
+        for k in 0..wl.out.len() {
+            let o = wl.out[k];
+            if !o.active {
+                continue;
+            }
+            let w = wl.wall[k] as usize;
+            let on_mesh = matches!(self.walls[w].shape, WallShape::Mesh(_));
+            let record = self.record_impacts && o.formed;
+            if !on_mesh && !record {
+                continue;
+            }
+            // Slots are stored particle by particle, so the owner only moves forward: the first particle
+            // at or after `i` whose slot range ends past k.
+            i += wl.start[i + 1..].partition_point(|&end| end as usize <= k);
+            if record {
+                let wall = &self.walls[w];
+                let (normal, v_wall) =
+                    super::impacts::contact_frame(wall, &self.scratch.kin[w], wl.tri[k], p.pos[i]);
+                self.impacts.push(super::WallImpact {
+                    particle: p.id[i],
+                    body: p.is_member(i).then(|| bodies.id[p.body[i] as usize]),
+                    wall: w,
+                    triangle: on_mesh.then_some(wl.tri[k]),
+                    time: self.st.time,
+                    normal,
+                    velocity: p.vel[i] - v_wall,
+                });
+            }
+            let wall = &mut self.walls[w];
+            let wall_material = wall.material as usize;
+            if let WallShape::Mesh(m) = &mut wall.shape {
+                let t = wl.tri[k] as usize;
+                let r = &mut m.records;
+                let ft = (o.force.length_squared() - o.normal_force * o.normal_force).max(0.0).sqrt();
+                r.normal_impulse[t] += o.normal_force.abs() * dt;
+                r.tangential_impulse[t] += ft * dt;
+                if o.formed {
+                    let v_n = o.approach_speed.max(0.0);
+                    r.impacts[t] += 1;
+                    r.impact_speed_sum[t] += o.approach_speed;
+                    r.impact_angle_sum[t] += v_n.atan2(o.tangential_speed).to_degrees();
+                    if let Some(model) = self.wear.get(p.material[i] as usize, wall_material) {
+                        // The impacting mass: the whole body for a clump member.
+                        let mass = if p.is_member(i) { bodies.mass(p.body[i] as usize) } else { p.mass(i) };
+                        r.eroded_mass[t] += model.eroded_mass(mass, v_n, o.tangential_speed);
                     }
                 }
             }
