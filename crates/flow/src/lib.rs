@@ -10,7 +10,7 @@
 //!   lift-off map;
 //! * [`tracker`] — parcels, injection, the integrator, wall rules on STL bodies, deposition statistics
 //!   and the exact mass balance;
-//! * [`validation`] — reference cases for `spatter validate`; [`bench`] — `spatter bench track`.
+//! * [`validation`] — reference cases for `spatter validate`; [`bench`](mod@bench) — `spatter bench track`.
 //!
 //! Every quantity is SI. Forces are per unit particle mass (accelerations) unless a function says
 //! otherwise.

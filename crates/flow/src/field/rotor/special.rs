@@ -145,7 +145,7 @@ fn table_lookup(table: &[f64], t: f64) -> f64 {
     w[0] * table[i - 1] + w[1] * table[i] + w[2] * table[i + 1] + w[3] * table[i + 2]
 }
 
-/// E₁(x) from the tables of [`E1_TABLES`] (relative error below 10⁻¹⁰, tested against
+/// E₁(x) from the tables of `E1_TABLES` (relative error below 10⁻¹⁰, tested against
 /// [`exp_integral_e1`]); zero from [`CORE_CUTOFF`] on.
 #[inline]
 pub fn exp_integral_e1_fast(x: f64) -> f64 {
