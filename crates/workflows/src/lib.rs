@@ -5,6 +5,7 @@ pub mod brownout;
 pub mod cfd;
 pub mod dem_scene;
 pub mod deposition;
+pub mod gravelometer;
 pub mod snow;
 pub mod sph_scene;
 pub mod wading;
