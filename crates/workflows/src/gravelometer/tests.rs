@@ -289,3 +289,23 @@ fn eroded_mass_and_spread_move_as_the_published_parametric_study_found() {
     assert!(spread_54 > spread_90, "impact spread at 54° {spread_54} vs 90° {spread_90}");
     assert!(em_54 > em_slow, "eroded mass at 12 m/s {em_54:e} vs 6 m/s {em_slow:e}");
 }
+
+#[test]
+fn the_sphere_mode_is_the_single_particle_steel_ball() {
+    // Qian et al. (2022), single-particle tests S1–S5: a 5 mm steel ball of 615 spheres of 0.5 mm (solid
+    // fraction 615 · (0.5/5)³ = 0.615). The equal-sphere fill here packs at most the face-centred cubic
+    // density 0.74; the ball keeps the mass of the solid steel ball, ρ π D³ / 6.
+    let cfg = load(
+        "standard = \"din_55996_1\"\n[stones]\nshape = \"sphere\"\nsphere_diameter_m = 0.005\n\
+         member_diameter_m = 5e-4\ndensity_kg_m3 = 7850.0",
+    );
+    let p = plan(&cfg).unwrap();
+    assert_eq!(p.stones.len(), 1);
+    let ball = &p.stones[0];
+    let n = ball.template.spheres.len() as f64;
+    let fraction = n * (0.5f64 / 5.0).powi(3);
+    assert!(fraction > 0.5 && fraction <= 0.7405, "{n} members, solid fraction {fraction}");
+    let m = 7850.0 * std::f64::consts::PI * 0.005f64.powi(3) / 6.0;
+    assert!((ball.mass - m).abs() < 1e-12 * m, "{} vs {m}", ball.mass);
+    assert!((ball.diameter - 0.005).abs() < 1e-12);
+}
