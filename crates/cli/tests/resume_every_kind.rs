@@ -406,3 +406,32 @@ fn brownout_resumes_bit_for_bit() {
     let s = write(dir.path(), "brownout.toml", text.as_bytes());
     stop_and_resume(&s, 12, "brownout");
 }
+
+#[test]
+fn gravelometer_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    // Four one-sphere stones through a short pipe onto the DIN panel.
+    let text = r#"kind = "gravelometer"
+standard = "din_55996_1"
+duration_s = 0.012
+[pipe]
+length_m = 0.05
+[panel]
+distance_m = 0.06
+triangle_size_m = 0.02
+[stones]
+count = 4
+feed_time_s = 0.002
+youngs_modulus_pa = 1e9
+[stones.templates.ball]
+shape = { type = "ball", radius_m = 2.5e-3 }
+packing = { type = "count", sphere_count = 1 }
+[launch]
+speed_m_s = 12.0
+[results]
+particles_vtu = true
+output_interval_s = 0.002
+"#;
+    let s = write(dir.path(), "gravelometer.toml", text.as_bytes());
+    stop_and_resume(&s, 12, "gravelometer");
+}

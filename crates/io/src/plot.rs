@@ -383,6 +383,12 @@ pub struct FieldMap<'a> {
 /// to 300 px) with axes, ticks, a title across the picture and a viridis colour bar spanning the finite
 /// values.
 pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
+    field_map_png_with_lines(path, map, &[])
+}
+
+/// [`field_map_png`] with horizontal lines across the map at heights `lines` (e.g. the boundaries of
+/// regions), each labelled with its text at the right end, drawn in white over a black outline.
+pub fn field_map_png_with_lines(path: &Path, map: &FieldMap, lines: &[(f64, String)]) -> io::Result<()> {
     let (nx, ny) = (map.x_faces.len().saturating_sub(1), map.y_faces.len().saturating_sub(1));
     if nx == 0 || ny == 0 || map.values.len() != nx * ny {
         return Err(err(path, format!("{} values for a {nx} × {ny} grid", map.values.len())));
@@ -456,6 +462,25 @@ pub fn field_map_png(path: &Path, map: &FieldMap) -> io::Result<()> {
             })
         }))
         .map_err(e)?;
+    for (y, text) in lines {
+        for (color, width) in [(BLACK, 3), (WHITE, 1)] {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(x0, *y), (x1, *y)],
+                    color.stroke_width(width),
+                )))
+                .map_err(e)?;
+        }
+        if !text.is_empty() {
+            let at = chart.backend_coord(&(x1, *y));
+            left.draw(&Text::new(
+                text.clone(),
+                (at.0 - 8 * text.chars().count() as i32 - 4, at.1 + 3),
+                ("sans-serif", 13).into_font().color(&WHITE),
+            ))
+            .map_err(e)?;
+        }
+    }
     let top = 60;
     let bottom = (h as i32 - 110).min(top + 440);
     colour_bar(&right, 30, (top, bottom), (vmin, vmax), map.colorbar_label, 15).map_err(e)?;

@@ -82,6 +82,8 @@ kinds! {
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
+    "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run),
+        "Stone-chip test (DIN 55996-1, SAE J400): stones shot through a pipe at a coated panel; damage map, strip shares, impact statistics.";
     "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
         "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";
 }

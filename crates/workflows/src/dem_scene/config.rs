@@ -833,7 +833,17 @@ impl Validate for SceneConfig {
         }
         c.nested("output", |c| {
             if let Some(e) = &self.output.events {
-                c.nested("events", |c| e.validate(c));
+                c.nested("events", |c| {
+                    e.validate(c);
+                    for (k, name) in e.first_impact_walls.iter().enumerate() {
+                        if !self.walls.iter().any(|w| w.name == *name) {
+                            c.fail(
+                                &format!("first_impact_walls[{k}]"),
+                                format!("\"{name}\" is not the name of a wall in [[walls]]"),
+                            );
+                        }
+                    }
+                });
             }
             if let Some(t) = &self.output.trajectories {
                 c.nested("trajectories", |c| t.validate(c));

@@ -27,6 +27,10 @@ pub struct EventsConfig {
     /// A plane whose first crossing by each body or sphere is recorded, `{ point_m, normal }`.
     #[serde(default)]
     pub crossing_plane: Option<CrossingPlane>,
+    /// Names of the walls whose contacts count as a first impact (default: every wall). Collisions are
+    /// counted on every wall either way.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub first_impact_walls: Vec<String>,
 }
 
 /// A plane through `point_m` with normal `normal` (need not be unit length).
@@ -91,34 +95,49 @@ fn check_direction(c: &mut Checker, key: &str, v: Vec3) {
 /// A body (`true`) or a free sphere (`false`) and its stable id.
 type Key = (bool, u32);
 
+/// The first wall impact of a body or free sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-struct FirstImpact {
-    t: f64,
-    wall: usize,
-    triangle: Option<u32>,
-    speed: f64,
-    normal_speed: f64,
-    angle_deg: f64,
-    plane_angle_deg: f64,
+pub struct FirstImpact {
+    /// Time \[s\].
+    pub t: f64,
+    /// Index of the wall.
+    pub wall: usize,
+    /// Triangle of a mesh wall.
+    pub triangle: Option<u32>,
+    /// |v| of the touching sphere's centre relative to the wall \[m/s\].
+    pub speed: f64,
+    /// Approach speed along the wall normal \[m/s\].
+    pub normal_speed: f64,
+    /// Angle between the velocity and the wall plane \[deg\].
+    pub angle_deg: f64,
+    /// The same angle seen in the plane of `angle_plane_normal` \[deg\] (NaN without one).
+    pub plane_angle_deg: f64,
+    /// Velocity of the touching sphere's centre relative to the wall \[m/s\].
+    pub velocity: Vec3,
 }
 
+/// The first crossing of the crossing plane.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-struct Crossing {
-    t: f64,
-    pos: Vec3,
-    dir: Vec3,
+pub struct Crossing {
+    /// Time \[s\].
+    pub t: f64,
+    /// Centre (of mass) at the end of the step that crossed \[m\].
+    pub pos: Vec3,
+    /// Unit direction of motion there.
+    pub dir: Vec3,
 }
 
+/// What the log knows of one body or free sphere.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-struct ObjectRecord {
+pub struct ObjectRecord {
     /// Template index of a body, −1 for a sphere.
-    template: i64,
-    first: Option<FirstImpact>,
+    pub template: i64,
+    pub first: Option<FirstImpact>,
     /// Contacts formed per wall (a body touching a wall with several members in one step counts once).
-    collisions: Vec<u64>,
+    pub collisions: Vec<u64>,
     /// Signed distance to the crossing plane after the last step (NaN before the first).
     side: f64,
-    crossing: Option<Crossing>,
+    pub crossing: Option<Crossing>,
 }
 
 /// The state of the event log (checkpointed).
@@ -147,6 +166,10 @@ impl EventLog {
             bodies.id.binary_search(&b).map_or(-1, |k| bodies.template[k] as i64)
         };
         let plane = cfg.angle_plane_normal.map(|m| m.normalize());
+        let counts_as_first = |w: usize| {
+            cfg.first_impact_walls.is_empty()
+                || cfg.first_impact_walls.iter().any(|n| *n == sim.walls[w].name)
+        };
         let mut counted: Vec<(Key, usize)> = Vec::new();
         for imp in sim.last_impacts() {
             let key: Key = match imp.body {
@@ -158,6 +181,9 @@ impl EventLog {
             if !counted.contains(&(key, imp.wall)) {
                 counted.push((key, imp.wall));
                 rec.collisions[imp.wall] += 1;
+            }
+            if !counts_as_first(imp.wall) {
+                continue;
             }
             let candidate = first_impact(imp, plane);
             // Among the contacts of one object that form in the same step, the fastest normal approach.
@@ -200,6 +226,9 @@ impl EventLog {
             "first_impact_normal_speed_m_s",
             "first_impact_angle_deg",
             "first_impact_plane_angle_deg",
+            "first_impact_vx_m_s",
+            "first_impact_vy_m_s",
+            "first_impact_vz_m_s",
         ]
         .iter()
         .map(|s| s.to_string())
@@ -242,8 +271,13 @@ impl EventLog {
                         Some(f.angle_deg),
                         // NaN by design when the velocity has no component in the plane.
                         Some(f.plane_angle_deg).filter(|a| !a.is_nan()),
+                        Some(f.velocity.x),
+                        Some(f.velocity.y),
+                        Some(f.velocity.z),
                     ]),
-                    None => row.extend([None, Some(-1.0), Some(-1.0), None, None, None, None]),
+                    None => {
+                        row.extend([None, Some(-1.0), Some(-1.0), None, None, None, None, None, None, None])
+                    }
                 }
                 row.extend(r.collisions.iter().map(|&c| Some(c as f64)));
                 match &r.crossing {
@@ -255,6 +289,12 @@ impl EventLog {
                 row
             })
             .collect()
+    }
+
+    /// Every body (`true`) or free sphere (`false`) the log knows, with its stable id and record, in id
+    /// order (bodies and spheres mixed).
+    pub fn objects(&self) -> impl Iterator<Item = ((bool, u32), &ObjectRecord)> {
+        self.records.iter().map(|(k, r)| (*k, r))
     }
 
     /// Objects that hit a wall, and objects that crossed the plane.
@@ -274,6 +314,7 @@ fn first_impact(imp: &WallImpact, plane: Option<Vec3>) -> FirstImpact {
         normal_speed: -imp.velocity.dot(imp.normal),
         angle_deg: imp.angle_deg(),
         plane_angle_deg: plane.map_or(f64::NAN, |m| imp.angle_in_plane_deg(m)),
+        velocity: imp.velocity,
     }
 }
 

@@ -3,12 +3,12 @@
 
 mod clumps;
 mod config;
-mod events;
+pub mod events;
 mod run;
 pub mod setup;
 
 pub use config::*;
-pub use run::run;
+pub use run::{run, run_collect, MeshWallResult, SceneResults};
 
 #[cfg(test)]
 mod tests;

@@ -47,6 +47,61 @@ struct Checkpoint<S> {
 /// `checkpoint.bin`) when `ctx.control` asks; with `ctx.resume` continues from the checkpoint so that the
 /// outputs equal those of an uninterrupted run bit for bit.
 pub fn run(cfg: &SceneConfig, ctx: &RunContext) -> Result<RunSummary, DemError> {
+    run_collect(cfg, ctx).map(|(summary, _)| summary)
+}
+
+/// What a finished scene leaves for a workflow built on it (see [`run_collect`]).
+#[derive(Clone, Debug)]
+pub struct SceneResults {
+    /// Per mesh wall (in `[[walls]]` order, analytic walls left out): its name and per triangle the
+    /// eroded mass \[kg\] and the impacts.
+    pub mesh_walls: Vec<MeshWallResult>,
+    /// The event log (empty without `[output.events]`).
+    pub events: EventLog,
+    /// The rigid bodies present at the end: id, template index (alphabetical order of `[templates]`)
+    /// and centre of mass \[m\].
+    pub bodies: Vec<(u32, u32, Vec3)>,
+    /// Member spheres in each template, in template order.
+    pub template_members: Vec<usize>,
+    /// Particles (spheres, members included) removed for leaving the domain.
+    pub removed_spheres: u64,
+}
+
+/// Per-triangle records of one mesh wall at the end of a run.
+#[derive(Clone, Debug)]
+pub struct MeshWallResult {
+    pub name: String,
+    pub eroded_mass: Vec<f64>,
+    pub impacts: Vec<u64>,
+}
+
+fn results<L: ContactLaw>(sim: &Simulation<L>, events: EventLog) -> SceneResults {
+    let mut mesh_walls = Vec::new();
+    for w in &sim.walls {
+        if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
+            mesh_walls.push(MeshWallResult {
+                name: w.name.clone(),
+                eroded_mass: m.records.eroded_mass.clone(),
+                impacts: m.records.impacts.clone(),
+            });
+        }
+    }
+    let b = sim.bodies();
+    SceneResults {
+        mesh_walls,
+        events,
+        bodies: (0..b.len()).map(|k| (b.id[k], b.template[k], b.pos[k])).collect(),
+        template_members: sim.templates().iter().map(|t| t.spheres.len()).collect(),
+        removed_spheres: sim.removed_count(),
+    }
+}
+
+/// Like [`run`], and for a completed run also the [`SceneResults`] (`None` when the run was
+/// interrupted), so that a workflow composing a scene reads its records without re-reading files.
+pub fn run_collect(
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
     Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
     let c = &cfg.contact;
     let damping = RestitutionDamping {
@@ -256,7 +311,7 @@ fn run_with<L: ContactLaw>(
     built: setup::Built,
     cfg: &SceneConfig,
     ctx: &RunContext,
-) -> Result<RunSummary, DemError> {
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
     let e = &cfg.engine;
     let settings = spatter_dem::sim::Settings {
         integrator: e.integrator,
@@ -415,7 +470,7 @@ fn run_with<L: ContactLaw>(
                 sim.step_count(),
                 sim.time()
             ));
-            return Ok(s);
+            return Ok((s, None));
         }
         let step = sim.step_count();
         for (k, (inj, region)) in injectors.iter_mut().enumerate() {
@@ -463,7 +518,8 @@ fn run_with<L: ContactLaw>(
     for (name, png) in write_wear_maps(&sim, ctx)? {
         s.artifacts.push((format!("eroded mass map {name}"), png));
     }
-    Ok(s)
+    let r = results(&sim, events);
+    Ok((s, Some(r)))
 }
 
 /// Writes `events.csv` (the whole log so far; rewritten at every checkpoint and at the end) when the

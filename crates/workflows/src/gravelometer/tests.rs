@@ -1,0 +1,311 @@
+//! Tests of the gravelometer workflow: presets against the published set-ups, refusals of bad input, the
+//! launch formula, a ballistic flight against Galileo's parabola, the fate of every stone, and the
+//! directions of the published parametric study on reduced cases.
+
+use super::config::{preset, GravelometerConfig, GravelometerInput, Standard};
+use super::scene::{empirical_launch_speed, feeder_vertical_speed, plan};
+use super::{run, GravelometerError};
+use spatter_core::check::Checker;
+use spatter_core::control::Unattended;
+use spatter_io::run::{RunContext, RunDir, RunSummary};
+use std::path::Path;
+
+fn load(text: &str) -> GravelometerConfig {
+    let input: GravelometerInput = toml::from_str(text).unwrap();
+    GravelometerConfig::from(input)
+}
+
+fn problems(text: &str) -> String {
+    let cfg = load(text);
+    match Checker::run(&cfg, None) {
+        Ok(()) => String::new(),
+        Err(v) => v.iter().map(|i| format!("{}: {}\n", i.key, i.message)).collect(),
+    }
+}
+
+fn scalar(s: &RunSummary, name: &str) -> f64 {
+    s.scalars.iter().find(|(n, _)| n == name).map_or(f64::NAN, |v| v.1)
+}
+
+#[test]
+fn presets_carry_the_published_set_ups_and_name_what_is_assumed() {
+    // Qian et al. (2022), CMES: DIN 55996-1 — 30 mm pipe, 500 g in 10 s, 100 × 200 mm panel at 54°, five
+    // strips, 1 s simulated; SAE J400 — 52 mm pipe, 31.1 m/s of air at 0.48 MPa, 100 × 300 mm upright
+    // panel, six strips, 2 s simulated; K_h = 59.6; 30 stones in the statistics; 40 impacts.
+    let din = load("standard = \"din_55996_1\"").input;
+    assert_eq!(din.pipe.diameter_m, Some(0.03));
+    assert_eq!(
+        (din.panel.width_m, din.panel.length_m, din.panel.angle_deg),
+        (Some(0.1), Some(0.2), Some(54.0))
+    );
+    assert_eq!(din.panel.strips, Some(5));
+    assert_eq!((din.stones.charge_kg, din.stones.feed_time_s), (Some(0.5), Some(10.0)));
+    assert_eq!(din.duration_s, Some(1.0));
+    assert_eq!(din.launch.k_h, Some(59.6));
+    assert_eq!((din.results.first_n, din.results.cutoff_impacts), (Some(30), Some(40)));
+    let sae = load("standard = \"sae_j400\"").input;
+    assert_eq!(sae.pipe.diameter_m, Some(0.052));
+    assert_eq!(sae.pipe.air_velocity_m_s, Some(31.1));
+    assert_eq!(
+        (sae.panel.width_m, sae.panel.length_m, sae.panel.angle_deg),
+        (Some(0.1), Some(0.3), Some(90.0))
+    );
+    assert_eq!(sae.panel.strips, Some(6));
+    assert_eq!(sae.stones.feed_time_s, Some(7.0));
+    assert_eq!(sae.duration_s, Some(2.0));
+    assert_eq!(sae.stones.templates.as_ref().map(|t| t.len()), Some(4));
+    // Air flow rate of the SAE pipe: 31.1 m/s × π (0.026 m)² = 0.06605 m³/s.
+    assert!((sae.launch.air_flow_m3_s.unwrap() - 0.066_046).abs() < 1e-5);
+    // Lost values are marked; a value the file sets is not.
+    for key in ["pipe.length_m", "panel.distance_m", "stones.youngs_modulus_pa", "wear.k_s2_m2"] {
+        assert!(sae.assumed.iter().any(|k| k == key), "{key} not marked: {:?}", sae.assumed);
+    }
+    assert!(!sae.assumed.iter().any(|k| k == "panel.angle_deg"));
+    let set = load("standard = \"sae_j400\"\n[pipe]\nlength_m = 0.4").input;
+    assert!(!set.assumed.iter().any(|k| k == "pipe.length_m"));
+    assert_eq!(set.pipe.length_m, Some(0.4));
+    // Every preset value is filled (and round-trips through the resolved TOML).
+    let text = toml::to_string(&GravelometerConfig { input: din.clone() }).unwrap();
+    let again: GravelometerConfig = toml::from_str(&text).unwrap();
+    assert_eq!(again.input.panel, din.panel);
+    assert!(text.contains("assumed"));
+    let (_, assumed) = preset(Standard::Din55996_1);
+    assert!(assumed.contains(&"pipe.air_velocity_m_s"));
+}
+
+#[test]
+fn bad_values_are_refused_with_the_key_and_the_expected_form() {
+    let p = problems("standard = \"din_55996_1\"\n[panel]\nangle_deg = 0.0");
+    assert!(p.contains("panel.angle_deg") && p.contains("outside (0°, 90°]"), "{p}");
+    let p = problems("standard = \"din_55996_1\"\n[panel]\nangle_deg = 95.0");
+    assert!(p.contains("panel.angle_deg"), "{p}");
+    assert!(problems("standard = \"din_55996_1\"\n[panel]\nangle_deg = 90.0").is_empty());
+    let p = problems("standard = \"sae_j400\"\n[panel]\ntriangle_size_m = 0.1\nstrips = 8");
+    assert!(p.contains("panel.strips") && p.contains("more than the 3 rows"), "{p}");
+    let p = problems("standard = \"sae_j400\"\nair = \"coupled\"");
+    assert!(p.contains("air") && p.contains("coupling"), "{p}");
+    let p = problems("standard = \"sae_j400\"\nair = \"prescribed\"");
+    assert!(p.contains("fluid-force hook"), "{p}");
+    let p = problems("standard = \"din_55996_1\"\n[contact]\nstone_wall_restitution = 1.5");
+    assert!(p.contains("contact.stone_wall_restitution"), "{p}");
+}
+
+#[test]
+fn a_stone_wider_than_the_pipe_and_a_feed_the_pipe_cannot_pass_are_refused() {
+    let cfg =
+        load("standard = \"din_55996_1\"\n[pipe]\ndiameter_m = 0.005\n[stones]\nmember_diameter_m = 2e-3");
+    match plan(&cfg) {
+        Err(GravelometerError::Config { key, message }) => {
+            assert_eq!(key, "stones");
+            assert!(message.contains("pipe.diameter_m = 0.005"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let cfg = load("standard = \"din_55996_1\"\n[stones]\nmember_diameter_m = 2e-3\ncharge_kg = 500.0\nfeed_time_s = 1.0");
+    match plan(&cfg) {
+        Err(GravelometerError::Config { key, message }) => {
+            assert_eq!(key, "stones.charge_kg");
+            assert!(message.contains("more than the pipe passes"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_launch_velocity_follows_the_empirical_formula_and_the_feeder_fall() {
+    // v_h = K_h Q_f / (ρ^{1/3} D): 59.6 × 0.0198 / (7400^{1/3} × 4.5e-3) = 13.45 m/s (hand calculation).
+    let v = empirical_launch_speed(59.6, 0.0198, 7400.0, 4.5e-3);
+    assert!((v - 59.6 * 0.0198 / (7400f64.cbrt() * 4.5e-3)).abs() < 1e-12);
+    assert!((v - 13.45).abs() < 0.01, "{v}");
+    // Proportional to the flow, falling with density and diameter (as the study found).
+    assert!(empirical_launch_speed(59.6, 0.04, 7400.0, 4.5e-3) > v);
+    assert!(empirical_launch_speed(59.6, 0.0198, 2650.0, 4.5e-3) > v);
+    assert!(empirical_launch_speed(59.6, 0.0198, 7400.0, 9e-3) < v);
+    // Free fall of 0.2 m: √(2 g h) = 1.981 m/s, times e = 0.5, downwards.
+    assert!((feeder_vertical_speed(0.2, 0.5, 9.81) + 0.5 * (2.0f64 * 9.81 * 0.2).sqrt()).abs() < 1e-12);
+    // The DIN preset: the mix's volume-equivalent diameter is that of the cut ball, ρ = 7400 kg/m³.
+    let cfg = load("standard = \"din_55996_1\"\n[stones]\nmember_diameter_m = 1.5e-3");
+    let p = plan(&cfg).unwrap();
+    // Cut ball of radius r with the lower third of the diameter removed: V = 80π r³/81, so
+    // D = (480/81)^{1/3} r = 4.5238 mm for r = 2.5 mm.
+    assert!((p.mean_diameter - (480.0f64 / 81.0).cbrt() * 2.5e-3).abs() < 1e-9, "{}", p.mean_diameter);
+    let q = 28.0 * std::f64::consts::PI * 0.015 * 0.015;
+    assert!((p.launch.x - empirical_launch_speed(59.6, q, 7400.0, p.mean_diameter)).abs() < 1e-9);
+    assert!((p.launch.z - feeder_vertical_speed(0.2, 0.5, 9.81)).abs() < 1e-12);
+}
+
+/// A reduced gravelometer: one-sphere "stones" of 5 mm (a single member each), soft enough for a large
+/// time step, a 0.1 m pipe and the panel 0.1 m further on; `top`, `stones` and `launch` add keys to the
+/// top level and to `[stones]` and `[launch]`.
+fn reduced(top: &str, stones: &str, launch: &str) -> String {
+    format!(
+        r#"standard = "din_55996_1"
+duration_s = 0.03
+{top}
+[pipe]
+length_m = 0.1
+[panel]
+distance_m = 0.1
+triangle_size_m = 0.01
+[stones]
+youngs_modulus_pa = 1e9
+{stones}
+[stones.templates.ball]
+shape = {{ type = "ball", radius_m = 2.5e-3 }}
+packing = {{ type = "count", sphere_count = 1 }}
+[launch]
+fall_height_m = 0.0
+{launch}
+[results]
+particles_vtu = false
+output_interval_s = 0.001
+"#
+    )
+}
+
+fn run_in(dir: &Path, text: &str) -> RunSummary {
+    let cfg = load(text);
+    Checker::run(&cfg, None).unwrap();
+    let d = RunDir::create(dir).unwrap();
+    run(&cfg, &RunContext::new(&d, &Unattended, false)).unwrap()
+}
+
+fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    (head, lines.map(|l| l.split(',').map(str::to_owned).collect()).collect())
+}
+
+#[test]
+fn a_stone_flies_galileos_parabola_onto_the_panel() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = run_in(tmp.path(), &reduced("", "count = 1\nfeed_time_s = 0.001", "speed_m_s = 12.0"));
+    // The stone's state inside the pipe from trajectories.csv.
+    let (head, rows) = csv(&tmp.path().join("trajectories.csv"));
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
+    let row0: Vec<f64> = rows[0].iter().map(|c| c.parse().unwrap()).collect();
+    let (t0, x0, z0) = (row0[col("t_s")], row0[col("x_m")], row0[col("z_m")]);
+    let (vx, vz) = (row0[col("vx_m_s")], row0[col("vz_m_s")]);
+    assert!((vx - 12.0).abs() < 1e-9, "{vx}");
+    // Galileo: x = x0 + vx τ, z = z0 + vz τ − g τ²/2; the sphere (radius r) touches the panel plane when
+    // its centre is r in front of it: (p − c)·n = r, n = (−sin 54°, 0, cos 54°), c = (0.1, 0, 0).
+    // The stone's one member (the largest sphere the fill finds inside the 2.5 mm ball).
+    let cfg = load(&reduced("", "count = 1\nfeed_time_s = 0.001", "speed_m_s = 12.0"));
+    let r = plan(&cfg).unwrap().stones[0].template.spheres[0].1;
+    assert!((r - 2.5e-3).abs() < 0.1e-3, "{r}");
+    let g = 9.81;
+    let th = 54f64.to_radians();
+    let (nx, nz) = (-th.sin(), th.cos());
+    let f = |tau: f64| (x0 + vx * tau - 0.1) * nx + (z0 + vz * tau - 0.5 * g * tau * tau) * nz - r;
+    let (mut a, mut b) = (0.0, 0.1);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if f(m) > 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    let tau = 0.5 * (a + b);
+    let (head, rows) = csv(&tmp.path().join("impacts.csv"));
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert_eq!(rows[0][col("wall")], "panel");
+    let get = |n: &str| rows[0][col(n)].parse::<f64>().unwrap();
+    let dt = scalar(&s, "dt_s");
+    // Impact time within two steps (contact is detected at the end of the step that closes the gap).
+    assert!((get("t_s") - (t0 + tau)).abs() < 2.0 * dt, "t {} vs {}", get("t_s"), t0 + tau);
+    // Impact speed: |v| = √(vx² + (vz − g τ)²) within 0.1 % (the contact sees the half-step velocity).
+    let vz_hit = vz - g * tau;
+    let speed = vx.hypot(vz_hit);
+    assert!((get("speed_m_s") - speed).abs() < 1e-3 * speed, "{} vs {speed}", get("speed_m_s"));
+    // Impact angle α against the panel's up direction (cos 54°, 0, sin 54°): acos(v·u/|v|), 0.1°.
+    let alpha = ((vx * th.cos() + vz_hit * th.sin()) / speed).acos().to_degrees();
+    assert!((get("angle_deg") - alpha).abs() < 0.1, "{} vs {alpha}", get("angle_deg"));
+    // Height of the impact on the panel from its bottom edge (0.1 m below the centre along the edge):
+    // the contact point is r behind the centre along −n; the triangle centroid is within one triangle.
+    let (xc, zc) = (x0 + vx * tau - r * nx, z0 + vz * tau - 0.5 * g * tau * tau - r * nz);
+    let s_hit = (xc - 0.1) * th.cos() + zc * th.sin() + 0.1;
+    assert!((get("height_on_panel_m") - s_hit).abs() < 0.01, "{} vs {s_hit}", get("height_on_panel_m"));
+    assert_eq!(get("pipe_collisions"), 0.0);
+    // The eroded mass is Finnie's: an impact at 54° erodes (f(54°) = 0.115 > 0).
+    assert!(scalar(&s, "panel_eroded_mass_kg") > 0.0);
+}
+
+#[test]
+fn every_injected_stone_is_accounted_for() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = reduced("", "count = 8\nfeed_time_s = 0.004", "");
+    let s = run_in(tmp.path(), &text.replace("duration_s = 0.03", "duration_s = 0.05"));
+    let injected = scalar(&s, "stones_injected");
+    assert_eq!(injected, 8.0);
+    let sum: f64 = ["stones_on_panel", "stones_in_box", "stones_in_pipe", "stones_out_of_domain"]
+        .iter()
+        .map(|k| scalar(&s, k))
+        .sum();
+    assert_eq!(sum, injected, "{:?}", s.scalars);
+    assert!(!s.headline.iter().any(|l| l.contains("WARNING")), "{:?}", s.headline);
+    let (_, rows) = csv(&tmp.path().join("stones.csv"));
+    assert_eq!(rows[0], ["injected", "8"]);
+    // The strip shares add up to 100 %.
+    let (_, strips) = csv(&tmp.path().join("strips.csv"));
+    assert_eq!(strips.len(), 5);
+    let total: f64 = strips.iter().map(|r| r[4].parse::<f64>().unwrap()).sum();
+    assert!((total - 100.0).abs() < 1e-9, "{total}");
+    for f in [
+        "panel_damage.png",
+        "panel_damage.vtu",
+        "strips.png",
+        "impact_speed_histogram.png",
+        "impact_statistics.csv",
+    ] {
+        assert!(tmp.path().join(f).is_file(), "{f}");
+    }
+}
+
+/// Directions of the parametric study of Qian et al. (2022), Figs. 22–25, on reduced cases (eight
+/// one-sphere stones, same seed, so that the cases differ only in the varied parameter):
+/// * the eroded mass grows as the impingement angle goes from 90° (upright panel, M0) to 54° (M2) —
+///   Finnie's f(90°) = 0 against f(54°) = 0.115;
+/// * the impacts spread over more of the panel as it tilts away from upright (the beam's height spread
+///   lands on a length 1/sin θ longer);
+/// * faster stones erode more (M3 < M0 < M4).
+#[test]
+fn eroded_mass_and_spread_move_as_the_published_parametric_study_found() {
+    let tmp = tempfile::tempdir().unwrap();
+    let case = |name: &str, angle: f64, speed: f64| {
+        let text = reduced("", "count = 8\nfeed_time_s = 0.004", &format!("speed_m_s = {speed}"))
+            .replace("distance_m = 0.1", &format!("distance_m = 0.1\nangle_deg = {angle}"));
+        let s = run_in(&tmp.path().join(name), &text.replace("duration_s = 0.03", "duration_s = 0.04"));
+        (scalar(&s, "panel_eroded_mass_kg"), scalar(&s, "height_on_panel_sd_m"))
+    };
+    let (em_90, spread_90) = case("m0", 90.0, 12.0);
+    let (em_54, spread_54) = case("m2", 54.0, 12.0);
+    let (em_slow, _) = case("m3", 54.0, 6.0);
+    // "As the impingement angle decreases from 90° to 54°, the eroded mass increases significantly":
+    // at least twice.
+    assert!(em_54 > 2.0 * em_90, "eroded mass at 54° {em_54:e} vs 90° {em_90:e}");
+    assert!(spread_54 > spread_90, "impact spread at 54° {spread_54} vs 90° {spread_90}");
+    assert!(em_54 > em_slow, "eroded mass at 12 m/s {em_54:e} vs 6 m/s {em_slow:e}");
+}
+
+#[test]
+fn the_sphere_mode_is_the_single_particle_steel_ball() {
+    // Qian et al. (2022), single-particle tests S1–S5: a 5 mm steel ball of 615 spheres of 0.5 mm (solid
+    // fraction 615 · (0.5/5)³ = 0.615). The equal-sphere fill here packs at most the face-centred cubic
+    // density 0.74; the ball keeps the mass of the solid steel ball, ρ π D³ / 6.
+    let cfg = load(
+        "standard = \"din_55996_1\"\n[stones]\nshape = \"sphere\"\nsphere_diameter_m = 0.005\n\
+         member_diameter_m = 5e-4\ndensity_kg_m3 = 7850.0",
+    );
+    let p = plan(&cfg).unwrap();
+    assert_eq!(p.stones.len(), 1);
+    let ball = &p.stones[0];
+    let n = ball.template.spheres.len() as f64;
+    let fraction = n * (0.5f64 / 5.0).powi(3);
+    assert!(fraction > 0.5 && fraction <= 0.7405, "{n} members, solid fraction {fraction}");
+    let m = 7850.0 * std::f64::consts::PI * 0.005f64.powi(3) / 6.0;
+    assert!((ball.mass - m).abs() < 1e-12 * m, "{} vs {m}", ball.mass);
+    assert!((ball.diameter - 0.005).abs() < 1e-12);
+}
