@@ -28,6 +28,7 @@
 pub mod exchange;
 #[cfg(test)]
 mod tests;
+pub mod validation;
 pub mod void_fraction;
 
 use crate::fluid_forces::{FluidForceOptions, FluidSampler};
