@@ -17,6 +17,7 @@ pub fn validation_cases() -> Vec<Case> {
     cases.extend(spatter_flow::validation::validation_cases());
     cases.extend(spatter_sph::validation::validation_cases());
     cases.extend(spatter_cfd::validation::validation_cases());
+    cases.extend(spatter_workflows::cfd_dem::validation::validation_cases());
     cases
 }
 

@@ -3,6 +3,7 @@
 
 pub mod brownout;
 pub mod cfd;
+pub mod cfd_dem;
 pub mod dem_scene;
 pub mod deposition;
 pub mod fluid_forces;

@@ -1,0 +1,287 @@
+//! Volume-averaged (unresolved) two-way CFD–DEM coupling: a `spatter-cfd` flow on a Cartesian grid and a
+//! DEM simulation exchanging momentum through the void fraction and the fluid forces on the spheres.
+//!
+//! One coupling step (fluid step Δt_f = N Δt_DEM):
+//!
+//! 1. **void fraction** α per cell from the spheres ([`void_fraction`]);
+//! 2. **forces**: at each sphere the interstitial velocity u = U/α (U the solver's superficial
+//!    velocity), ∇p interpolated from the face gradients, α of its cell; the fluid force of
+//!    [`FluidForceOptions`] (drag law, K-correction) by the [`MomentumModel`]; the forces are written
+//!    into the DEM's persistent external forces and held constant for the N DEM steps;
+//! 3. **exchange**: minus the exchanged force of every sphere is spread onto the velocity nodes around
+//!    it (the same trilinear stencil the velocity is sampled with) as a body force; the momentum the
+//!    fluid receives, Σ ρ V a over the nodes, is compared with the momentum taken from the spheres
+//!    ([`ExchangeReport`]);
+//! 4. **fluid** step Δt_f (explicit source);
+//! 5. **DEM**: N steps.
+//!
+//! The fluid solver advances the superficial velocity U = α u with ∇·U = 0 and
+//! ρ (∂U/∂t + ∇·(U U)) = −∇p + μ ∇²U − f, f the exchanged force per unit volume: the steady balances of
+//! both momentum models are exact (a fixed bed gives Ergun's pressure drop), while the α in the time
+//! derivative, in convection (U U/α) and in the continuity equation (∂α/∂t) is neglected — a
+//! quasi-static bed approximation, good for fixed and slowly expanding beds, not for fast dense
+//! transients (see docs/cfd.md, "CFD–DEM coupling").
+//!
+//! The solver's pressure p excludes the hydrostatic part ρ_f g·x; its force on a sphere, Archimedes'
+//! −ρ_f V g, is added to every sphere and balanced by the hydrostatic pressure, so it is not exchanged.
+
+pub mod exchange;
+#[cfg(test)]
+mod tests;
+pub mod validation;
+pub mod void_fraction;
+
+use crate::fluid_forces::{FluidForceOptions, FluidSampler};
+use exchange::{pressure_gradient_nodes, GridFluid};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use spatter_cfd::{Flow, FlowError, Mode};
+use spatter_core::check::{Checker, Validate};
+use spatter_core::Vec3;
+use spatter_dem::contact::ContactLaw;
+use spatter_dem::{DemError, Simulation};
+use std::time::Instant;
+pub use void_fraction::{VoidFraction, VoidFractionMethod};
+
+/// Which terms of the fluid–particle force go where (Zhou, Kuang, Chu & Yu 2010, J. Fluid Mech.
+/// 661:482–510, "set I" = model A, "set II" = model B; the two of CFDEM®coupling).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MomentumModel {
+    /// A sphere feels drag + the dynamic pressure-gradient force −V∇p + buoyancy; the fluid receives
+    /// minus drag and pressure-gradient force (at steady state −α∇p balances the drag, the form of the
+    /// model-A fluid equation). The default.
+    #[default]
+    A,
+    /// A sphere feels drag/α + buoyancy (no dynamic pressure-gradient force); the fluid receives minus
+    /// drag/α (the fluid equation of model B, where −∇p balances the drag/α).
+    B,
+}
+
+/// Coupling options.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingOptions {
+    /// Drag law and K-correction; the fluid's density and viscosity are the flow's.
+    #[serde(flatten)]
+    pub forces: FluidForceOptions,
+    #[serde(default)]
+    pub model: MomentumModel,
+    #[serde(default)]
+    pub void_fraction: VoidFractionMethod,
+    /// Lower clamp of the void fraction (default 0.3).
+    #[serde(default = "default_alpha_min")]
+    pub alpha_min: f64,
+    /// DEM steps per fluid step (default 10).
+    #[serde(default = "default_substeps")]
+    pub dem_steps_per_fluid_step: u32,
+}
+
+fn default_alpha_min() -> f64 {
+    0.3
+}
+fn default_substeps() -> u32 {
+    10
+}
+
+impl Default for CouplingOptions {
+    fn default() -> Self {
+        CouplingOptions {
+            forces: FluidForceOptions::default(),
+            model: MomentumModel::A,
+            void_fraction: VoidFractionMethod::Divided,
+            alpha_min: default_alpha_min(),
+            dem_steps_per_fluid_step: default_substeps(),
+        }
+    }
+}
+
+impl Validate for CouplingOptions {
+    fn validate(&self, c: &mut Checker) {
+        c.nested("k_correction", |c| self.forces.k_correction.validate(c));
+        c.in_range("alpha_min", self.alpha_min, 0.0, false, 1.0, false);
+        if self.dem_steps_per_fluid_step == 0 {
+            c.fail("dem_steps_per_fluid_step", "= 0: give at least 1 DEM step per fluid step");
+        }
+    }
+}
+
+/// The momentum balance of one coupling step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExchangeReport {
+    /// Σ of the exchanged fluid forces on the spheres inside the grid \[N\].
+    pub from_particles: Vec3,
+    /// Σ ρ V a of the body force the fluid received \[N\].
+    pub to_fluid: Vec3,
+    /// |to_fluid + from_particles| / max(|from_particles|, 1e-300).
+    pub relative_mismatch: f64,
+    /// Spheres outside the grid (no fluid force).
+    pub outside: u64,
+    /// Smallest void fraction of a fluid cell.
+    pub alpha_min: f64,
+}
+
+/// Wall time spent in each part of the coupling \[s\].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CouplingTimes {
+    pub fluid: f64,
+    pub void_fraction: f64,
+    pub forces: f64,
+    pub dem: f64,
+}
+
+/// Why a coupled step failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CouplingError {
+    #[error("CFD–DEM coupling needs a Cartesian grid (the axisymmetric mode has no 3D particle cells)")]
+    NotCartesian,
+    #[error("fluid: {0}")]
+    Flow(#[from] FlowError),
+    #[error("DEM: {0}")]
+    Dem(#[from] DemError),
+}
+
+/// A flow and a DEM simulation coupled two-way.
+pub struct Coupled<L: ContactLaw> {
+    pub flow: Flow,
+    pub dem: Simulation<L>,
+    pub options: CouplingOptions,
+    void_fraction: VoidFraction,
+    grad_p: [Vec<f64>; 3],
+    /// Exchanged force per sphere of the current coupling step \[N\].
+    exchanged: Vec<Vec3>,
+    /// The spheres' forces of the current step \[N\] (exchanged + buoyancy).
+    on_particles: Vec<Vec3>,
+    inside: Vec<bool>,
+    pub times: CouplingTimes,
+    pub last: ExchangeReport,
+}
+
+impl<L: ContactLaw> Coupled<L> {
+    /// Couples `flow` and `dem`; the DEM's gravity is the coupling's (buoyancy −ρ_f V g).
+    pub fn new(flow: Flow, dem: Simulation<L>, mut options: CouplingOptions) -> Result<Self, CouplingError> {
+        if flow.grid.mode != Mode::Cartesian {
+            return Err(CouplingError::NotCartesian);
+        }
+        options.forces.fluid =
+            spatter_flow::forces::Fluid { density: flow.fluid.density, viscosity: flow.fluid.viscosity };
+        let void_fraction = VoidFraction::new(&flow.grid, options.void_fraction, options.alpha_min);
+        Ok(Coupled {
+            flow,
+            dem,
+            options,
+            void_fraction,
+            grad_p: Default::default(),
+            exchanged: Vec::new(),
+            on_particles: Vec::new(),
+            inside: Vec::new(),
+            times: CouplingTimes::default(),
+            last: ExchangeReport::default(),
+        })
+    }
+
+    /// The void fraction of the last coupling step.
+    pub fn void_fraction(&self) -> &VoidFraction {
+        &self.void_fraction
+    }
+
+    /// The fluid time step Δt_f = N Δt_DEM \[s\].
+    pub fn fluid_dt(&self) -> f64 {
+        self.options.dem_steps_per_fluid_step as f64 * self.dem.dt
+    }
+
+    /// Void fraction, forces and exchange at the current state (steps 1–3 of a coupling step), without
+    /// stepping; returns the momentum balance.
+    pub fn exchange(&mut self) -> ExchangeReport {
+        let t0 = Instant::now();
+        let p = &self.dem.particles;
+        self.void_fraction.update(&self.flow.grid, &self.flow.blocked, &p.pos, &p.radius);
+        let t1 = Instant::now();
+        pressure_gradient_nodes(&self.flow, &mut self.grad_p);
+        let n = p.len();
+        self.exchanged.resize(n, Vec3::ZERO);
+        self.on_particles.resize(n, Vec3::ZERO);
+        self.inside.resize(n, false);
+        let sampler =
+            GridFluid { flow: &self.flow, void_fraction: &self.void_fraction, grad_p: &self.grad_p };
+        let opts = &self.options;
+        let rho_f = self.flow.fluid.density;
+        let g = self.dem.gravity;
+        let t = self.flow.state.t;
+        const CHUNK: usize = 1024;
+        self.exchanged
+            .par_chunks_mut(CHUNK)
+            .zip(self.on_particles.par_chunks_mut(CHUNK))
+            .zip(self.inside.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(ch, ((ex, on), ins))| {
+                for k in 0..ex.len() {
+                    let i = ch * CHUNK + k;
+                    let Some(f) = sampler.fluid_at(p.pos[i], t, &mut 0) else {
+                        ex[k] = Vec3::ZERO;
+                        on[k] = Vec3::ZERO;
+                        ins[k] = false;
+                        continue;
+                    };
+                    let r = p.radius[i];
+                    let (drag, pforce) = opts.forces.parts(r, p.vel[i], &f);
+                    let e = match opts.model {
+                        MomentumModel::A => drag + pforce,
+                        MomentumModel::B => drag / f.alpha,
+                    };
+                    let buoyancy = if opts.forces.pressure_force {
+                        -(4.0 / 3.0 * std::f64::consts::PI * r * r * r) * rho_f * g
+                    } else {
+                        Vec3::ZERO
+                    };
+                    ex[k] = e;
+                    on[k] = e + buoyancy;
+                    ins[k] = true;
+                }
+            });
+        // Spread onto the fluid in particle order (a sequential scatter: the same sums on any thread
+        // count).
+        if let Some(force) = self.flow.force.as_mut() {
+            force.iter_mut().for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
+        }
+        let mut from = Vec3::ZERO;
+        let mut outside = 0;
+        for i in 0..n {
+            if !self.inside[i] {
+                outside += 1;
+                continue;
+            }
+            let e = self.exchanged[i];
+            if self.flow.add_point_force(p.pos[i].to_array(), (-e).to_array()) {
+                from += e;
+            } else {
+                outside += 1;
+            }
+        }
+        let (ext, _) = self.dem.particles.external_force_mut();
+        ext.copy_from_slice(&self.on_particles);
+        let to = Vec3::from(self.flow.total_body_force());
+        let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
+        let rel = (to + from).length() / from.length().max(1e-300);
+        self.last =
+            ExchangeReport { from_particles: from, to_fluid: to, relative_mismatch: rel, outside, alpha_min };
+        let t3 = Instant::now();
+        self.times.void_fraction += (t1 - t0).as_secs_f64();
+        self.times.forces += (t3 - t1).as_secs_f64();
+        self.last
+    }
+
+    /// One coupling step: exchange, one fluid step of Δt_f, N DEM steps.
+    pub fn step(&mut self) -> Result<ExchangeReport, CouplingError> {
+        let rep = self.exchange();
+        let dt = self.fluid_dt();
+        let t0 = Instant::now();
+        self.flow.step(dt)?;
+        let t1 = Instant::now();
+        self.dem.run_steps(self.options.dem_steps_per_fluid_step as u64)?;
+        let t2 = Instant::now();
+        self.times.fluid += (t1 - t0).as_secs_f64();
+        self.times.dem += (t2 - t1).as_secs_f64();
+        Ok(rep)
+    }
+}
