@@ -84,6 +84,8 @@ kinds! {
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
     "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
         "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";
+    "integrator_study" => IntegratorStudy(spatter_workflows::bed_lab::IntegratorStudyConfig, spatter_workflows::bed_lab::run_integrator_study),
+        "The ten DEM time integrators on analytic single contacts: error sweeps, observed orders beside Jasion (2013).";
 }
 
 #[allow(dead_code)]
