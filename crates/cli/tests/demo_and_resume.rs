@@ -31,10 +31,10 @@ fn demo_writes_a_complete_run_folder() {
         pvd.lines().filter_map(|l| l.split("file=\"").nth(1)?.split('"').next()).collect();
     assert!(frames.len() > 10, "{pvd}");
     for f in &frames {
-        let d = spatter_io::vtu::read(&out.join("samples").join(f)).unwrap();
+        let d = spatter_io::vtk::read(&out.join("samples").join(f)).unwrap();
         assert_eq!(d.points.len(), 1);
     }
-    spatter_io::vtu::read(&out.join("samples/wall.vtu")).unwrap();
+    spatter_io::vtk::read(&out.join("samples/wall.vtu")).unwrap();
     // The resolved input is itself a valid scenario.
     let (code, err) = check(&out.join("run.toml"));
     assert_eq!(code, 0, "run.toml does not check: {err}");

@@ -84,8 +84,16 @@ fn every_example_runs_to_the_end_at_smoke_size() {
         let mut vtus = Vec::new();
         files(&out, "vtu", &mut vtus);
         for v in &vtus {
-            let d = spatter_io::vtu::read(v).unwrap_or_else(|e| panic!("{name}: {}: {e}", v.display()));
+            let d = spatter_io::vtk::read(v).unwrap_or_else(|e| panic!("{name}: {}: {e}", v.display()));
             assert!(d.points.iter().all(|p| p.is_finite()), "{name}: {} has non-finite points", v.display());
+            for a in d.point_data.iter().chain(&d.cell_data) {
+                assert!(
+                    a.values.iter().all(|x| x.is_finite()),
+                    "{name}: {} array `{}` holds NaN or infinity",
+                    v.display(),
+                    a.name
+                );
+            }
         }
         // The resolved input of the reduced run is itself a valid scenario.
         let (code, err) = check(&out.join("run.toml"));

@@ -220,8 +220,8 @@ fn maps_of_every_case_are_redrawn_on_one_colour_scale() {
     let out = dir.path().join("s");
     ok(&sweep(&[], &study, &out, None));
     let peak = |case: &str| {
-        let vtu = spatter_io::vtu::read(&out.join("cases").join(case).join("bodies/plate.vtu")).unwrap();
-        vtu.cell_data["mass_per_area_kg_m2"].1.iter().copied().fold(0.0, f64::max)
+        let vtu = spatter_io::vtk::read(&out.join("cases").join(case).join("bodies/plate.vtu")).unwrap();
+        vtu.cell_array("mass_per_area_kg_m2").unwrap().values.iter().copied().fold(0.0, f64::max)
     };
     let (light, heavy) = (peak("case_00000"), peak("case_00001"));
     assert!(light > 0.0, "the plate must receive snow");

@@ -19,10 +19,10 @@ use crate::forces::model::{ForceModel, ForceSwitches};
 use crate::forces::Fluid;
 use crate::tracker::inject::NewParcel;
 use crate::tracker::{Parcel, TrackSettings, Tracker, CHUNK};
-use crate::vtk::{cell_type, DataArray, VtkDataset};
 use rayon::prelude::*;
 use spatter_core::rng::{seeded, RngExt};
 use spatter_core::{Aabb, Vec3};
+use spatter_io::vtk::{cell_type, DataArray, VtkDataset};
 use std::time::Instant;
 
 fn cellular(p: Vec3) -> Vec3 {

@@ -3,7 +3,7 @@
 //! * [`forces`] — the particle–fluid force library (drag laws, lift, torque, history, added mass, pressure
 //!   gradient, gravity/buoyancy, wall-bounded lift) and the nondimensional force ranking;
 //! * [`field`] — flow fields: analytic (uniform, stagnation point, vortices, wall jet, rotor downwash) and
-//!   imported from VTK files ([`vtk`]), with point location and interpolation, and turbulent dispersion;
+//!   imported from VTK files (`spatter_io::vtk`), with point location and interpolation, and turbulent dispersion;
 //! * [`cloud`] — the dust cloud: size classes, a ground source of parcels, concentration and optical
 //!   depth on a grid;
 //! * [`liftoff`] — wall shear along the ground, Shields exceedance, the asperity moment balance and the
@@ -25,4 +25,3 @@ pub mod forces;
 pub mod liftoff;
 pub mod tracker;
 pub mod validation;
-pub mod vtk;

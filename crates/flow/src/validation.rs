@@ -487,7 +487,8 @@ fn linear_field(_quick: bool) -> Vec<Check> {
         join(vec!["10".to_owned(); tets.len()]),
         join(points.iter().flat_map(|p| lin(*p).to_array()).map(|x| format!("{x:e}")).collect()),
     );
-    let ds = crate::vtk::xml::parse(xml.as_bytes(), std::path::Path::new("linear.vtu")).expect("valid VTU");
+    let ds =
+        spatter_io::vtk::xml::parse(xml.as_bytes(), std::path::Path::new("linear.vtu")).expect("valid VTU");
     let f = ImportedField::from_dataset(&ds, &ImportOptions::default()).expect("velocity present");
     let mut worst: f64 = 0.0;
     let mut s = 3u64;

@@ -6,7 +6,7 @@ use spatter_core::mesh::TriMesh;
 use spatter_core::Vec3;
 use spatter_flow::field::tetmesh::NONE;
 use spatter_flow::field::{FlowField, ImportOptions, ImportedField, Interpolation};
-use spatter_flow::vtk;
+use spatter_io::vtk;
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {

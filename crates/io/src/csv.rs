@@ -1,5 +1,9 @@
 //! CSV output. Column names carry their units (`t_s`, `ke_J`, `force_N`); values are written in a form
 //! that parses back to the identical `f64`.
+//!
+//! A value that is undefined by design (a probe with no fluid around it, an angle before the first
+//! impact) is an empty cell, written with [`CsvSeries::row_with_gaps`]; `NaN` in a file is always a
+//! failed computation, and the job driver refuses a run whose tables hold one.
 
 use crate::fmt_f64;
 use std::fs::{File, OpenOptions};
@@ -71,25 +75,34 @@ impl CsvSeries {
         Ok(())
     }
 
-    /// Appends one row; the number of values must match the header.
+    /// Appends one row; the number of values must match the header. A NaN is written as `NaN` (a failed
+    /// computation, which the job driver's final check refuses); use [`CsvSeries::row_with_gaps`] for
+    /// values that are undefined by design.
     pub fn row(&mut self, values: &[f64]) -> io::Result<()> {
-        if values.len() != self.columns {
+        self.write_row(values.len(), values.iter().map(|v| Some(*v)))
+    }
+
+    /// Appends one row in which `None` marks a value undefined by design, written as an empty cell
+    /// ([`read_series`] reads it back as NaN).
+    pub fn row_with_gaps(&mut self, values: &[Option<f64>]) -> io::Result<()> {
+        self.write_row(values.len(), values.iter().copied())
+    }
+
+    fn write_row(&mut self, len: usize, values: impl Iterator<Item = Option<f64>>) -> io::Result<()> {
+        if len != self.columns {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
-                format!(
-                    "{}: row has {} values, header has {}",
-                    self.path.display(),
-                    values.len(),
-                    self.columns
-                ),
+                format!("{}: row has {len} values, header has {}", self.path.display(), self.columns),
             ));
         }
-        let mut line = String::with_capacity(16 * values.len());
-        for (i, v) in values.iter().enumerate() {
+        let mut line = String::with_capacity(16 * len);
+        for (i, v) in values.enumerate() {
             if i > 0 {
                 line.push(',');
             }
-            line.push_str(&fmt_f64(*v));
+            if let Some(v) = v {
+                line.push_str(&fmt_f64(v));
+            }
         }
         line.push('\n');
         self.write_raw(line.as_bytes())?;
@@ -140,14 +153,16 @@ pub fn write_table(path: &Path, header: &[&str], rows: &[Vec<String>]) -> io::Re
     std::fs::write(path, out).map_err(|e| with_path(e, path))
 }
 
-/// Reads a numeric CSV written by [`CsvSeries`]: the header and the rows.
+/// Reads a numeric CSV written by [`CsvSeries`]: the header and the rows; an empty cell (a gap) reads
+/// as NaN.
 pub fn read_series(path: &Path) -> io::Result<(Vec<String>, Vec<Vec<f64>>)> {
     let text = std::fs::read_to_string(path).map_err(|e| with_path(e, path))?;
     let mut lines = text.lines();
     let header: Vec<String> = lines.next().unwrap_or("").split(',').map(str::to_owned).collect();
     let mut rows = Vec::new();
     for (i, l) in lines.enumerate() {
-        let row: Result<Vec<f64>, _> = l.split(',').map(str::parse).collect();
+        let row: Result<Vec<f64>, _> =
+            l.split(',').map(|c| if c.is_empty() { Ok(f64::NAN) } else { c.parse() }).collect();
         rows.push(row.map_err(|_| {
             io::Error::new(
                 io::ErrorKind::InvalidData,
@@ -179,6 +194,23 @@ mod tests {
         assert_eq!(rows, vec![vec![0.0, 1.0], vec![0.1, 0.25]]);
         let mut c = CsvSeries::create(&p, &["a"]).unwrap();
         assert!(c.row(&[1.0, 2.0]).is_err(), "width mismatch is an error");
+        assert!(c.row_with_gaps(&[None, None]).is_err(), "width mismatch is an error");
+    }
+
+    /// Undefined values are empty cells that read back as NaN; a NaN passed to `row` stays visible.
+    #[test]
+    fn gaps_are_empty_cells_and_nan_stays_nan() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("g.csv");
+        let mut a = CsvSeries::create(&p, &["t_s", "p_Pa", "v_m_s"]).unwrap();
+        a.row_with_gaps(&[Some(0.5), None, Some(-2.0)]).unwrap();
+        a.row(&[1.0, f64::NAN, 3.0]).unwrap();
+        drop(a);
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "t_s,p_Pa,v_m_s\n0.5,,-2\n1,NaN,3\n");
+        let (_, rows) = read_series(&p).unwrap();
+        assert_eq!(rows[0][0], 0.5);
+        assert!(rows[0][1].is_nan() && rows[1][1].is_nan());
+        assert_eq!(rows[1][2], 3.0);
     }
 
     /// A row written after FLUSH_INTERVAL is on disk with the rows before it while the series is still

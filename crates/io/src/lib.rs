@@ -2,8 +2,10 @@
 //!
 //! * [`run`] — the run folder, the context a job runs in and the summary it returns;
 //! * [`csv`] — time series with units in the header, resumable after a checkpoint;
-//! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes) and a strict reader for them;
+//! * [`vtu`] — VTK XML unstructured grids (particles and triangle meshes);
 //! * [`vtr`] — VTK XML rectilinear grids (structured flow fields);
+//! * [`vtk`] — the one VTK reader: legacy `.vtk` and XML `.vtu/.vts/.vtr/.vti` (ours, ParaView's,
+//!   OpenFOAM's `foamToVTK`) into one unstructured dataset, and `.pvd`/`.series` time series;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
 //! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
 //! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
@@ -19,6 +21,7 @@ pub mod report;
 pub mod run;
 pub mod runlog;
 pub mod summary;
+pub mod vtk;
 mod vtk_xml;
 pub mod vtr;
 pub mod vtu;

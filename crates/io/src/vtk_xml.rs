@@ -1,11 +1,9 @@
-//! Pieces shared by the VTK XML writers and readers ([`crate::vtu`], [`crate::vtr`]): inline `binary`
-//! data arrays (base64 of a `UInt64` byte count followed by the little-endian values, one stream per
-//! array, no compression) and their decoding.
+//! Pieces shared by the VTK XML writers ([`crate::vtu`], [`crate::vtr`]): inline `binary` data arrays
+//! (base64 of a `UInt64` byte count followed by the little-endian values, one stream per array, no
+//! compression). [`crate::vtk`] reads them back.
 
 use base64::Engine;
 use std::fmt::Write as _;
-use std::io;
-use std::path::Path;
 
 /// Values of one data array.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,38 +78,4 @@ pub(crate) fn write_section(s: &mut String, tag: &str, list: &[Array]) {
 
 pub(crate) fn xml_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-/// An `InvalidData` error naming the file.
-pub(crate) fn bad(path: &Path, msg: impl std::fmt::Display) -> io::Error {
-    io::Error::new(io::ErrorKind::InvalidData, format!("{}: {msg}", path.display()))
-}
-
-/// Decodes the text of an inline binary `<DataArray>` of type `ty` (`Float64`, `Int64` or `UInt8`) into
-/// f64 values, checking the byte count in its header.
-pub(crate) fn decode(path: &Path, ty: &str, name: &str, format: &str, text: &[u8]) -> io::Result<Vec<f64>> {
-    if format != "binary" {
-        return Err(bad(path, format!("array `{name}` has format `{format}`; expected binary")));
-    }
-    let raw = base64::engine::general_purpose::STANDARD
-        .decode(text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect::<Vec<u8>>())
-        .map_err(|e| bad(path, format!("array `{name}`: bad base64: {e}")))?;
-    if raw.len() < 8 {
-        return Err(bad(path, format!("array `{name}` has no header")));
-    }
-    let len = u64::from_le_bytes(raw[..8].try_into().unwrap_or([0; 8])) as usize;
-    let body = &raw[8..];
-    if body.len() != len {
-        return Err(bad(path, format!("array `{name}`: header says {len} B, found {} B", body.len())));
-    }
-    Ok(match ty {
-        "Float64" => {
-            body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect()
-        }
-        "Int64" => {
-            body.chunks_exact(8).map(|c| i64::from_le_bytes(c.try_into().unwrap_or([0; 8])) as f64).collect()
-        }
-        "UInt8" => body.iter().map(|&b| b as f64).collect(),
-        other => return Err(bad(path, format!("array `{name}` has unsupported type {other}"))),
-    })
 }

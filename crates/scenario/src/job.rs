@@ -222,8 +222,9 @@ fn write_summary(dir: &RunDir, loaded: &Loaded, s: &RunSummary, wall_s: f64) -> 
 }
 
 /// The run's results hold only finite numbers: every scalar is finite, and no CSV file of the run folder
-/// holds an infinity (NaN is how a table marks a value that is undefined by design). The first offender
-/// is named with its file, line and column.
+/// holds a NaN or an infinity (a value undefined by design is an empty cell, see
+/// `spatter_io::csv::CsvSeries::row_with_gaps`). The first offender is named with its file, line and
+/// column.
 pub fn check_finite(root: &Path, s: &RunSummary) -> Result<(), JobError> {
     for (name, v) in &s.scalars {
         if !v.is_finite() {
@@ -243,9 +244,19 @@ pub fn check_finite(root: &Path, s: &RunSummary) -> Result<(), JobError> {
         for (i, line) in lines {
             for (j, cell) in line.split(',').enumerate() {
                 let c = cell.trim().trim_matches('"').to_ascii_lowercase();
-                // NaN marks a quantity that is undefined by design (a probe without fluid, an overlap
-                // outside contact); infinity never is.
-                let bad = matches!(c.as_str(), "inf" | "-inf" | "+inf" | "infinity" | "-infinity");
+                // Undefined-by-design values are empty cells; NaN and infinity are failed computations.
+                let bad = matches!(
+                    c.as_str(),
+                    "nan"
+                        | "-nan"
+                        | "+nan"
+                        | "inf"
+                        | "-inf"
+                        | "+inf"
+                        | "infinity"
+                        | "-infinity"
+                        | "+infinity"
+                );
                 if bad {
                     let col =
                         header.get(j).map(|h| format!("column `{h}`")).unwrap_or(format!("column {}", j + 1));
@@ -311,5 +322,34 @@ impl RunControl for Timed<'_> {
         } else {
             false
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spatter_core::control::Finished;
+
+    /// The final check passes empty cells (values undefined by design) and names the file, line and
+    /// column of a NaN or an infinity in any table of the run folder, and of a non-finite scalar.
+    #[test]
+    fn final_check_refuses_nan_and_infinity_but_not_gaps() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("probes");
+        std::fs::create_dir(&sub).unwrap();
+        let table = sub.join("p.csv");
+        let ok = RunSummary::new(Finished::Completed);
+        std::fs::write(&table, "t_s,p_Pa\n0,\n1,2.5\n").unwrap();
+        assert!(check_finite(dir.path(), &ok).is_ok(), "an empty cell is a gap, not a failure");
+        for bad in ["NaN", "inf", "-inf"] {
+            std::fs::write(&table, format!("t_s,p_Pa\n0,1\n1,{bad}\n")).unwrap();
+            let msg = check_finite(dir.path(), &ok).unwrap_err().to_string();
+            assert!(msg.contains("p.csv:3") && msg.contains("column `p_Pa`") && msg.contains(bad), "{msg}");
+        }
+        std::fs::write(&table, "t_s,p_Pa\n0,1\n").unwrap();
+        let mut s = RunSummary::new(Finished::Completed);
+        s.scalar("total_J", f64::NEG_INFINITY);
+        let msg = check_finite(dir.path(), &s).unwrap_err().to_string();
+        assert!(msg.contains("total_J") && msg.contains("-inf"), "{msg}");
     }
 }

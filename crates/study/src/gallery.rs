@@ -14,9 +14,6 @@ use spatter_io::run::MeshMapRecord;
 use spatter_io::summary::SummaryFile;
 use std::path::{Path, PathBuf};
 
-/// VTK cell type of a linear triangle.
-const VTK_TRIANGLE: u8 = 5;
-
 /// One map redrawn for several cases on a common scale.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Gallery {
@@ -104,24 +101,20 @@ pub fn common_scale<'a>(cases: impl Iterator<Item = &'a [f64]>) -> (f64, f64) {
 
 /// The triangles of `vtu` and its one-component cell array `array`.
 fn read_map(vtu: &Path, array: &str) -> Result<(TriMesh, Vec<f64>), String> {
-    let data = spatter_io::vtu::read(vtu).map_err(|e| e.to_string())?;
-    let n_cells = data.types.len();
-    if data.types.iter().any(|&t| t != VTK_TRIANGLE)
-        || data.connectivity.len() != 3 * n_cells
-        || data.offsets.iter().enumerate().any(|(k, &o)| o != 3 * (k as i64 + 1))
-    {
+    let data = spatter_io::vtk::read(vtu).map_err(|e| e.to_string())?;
+    // The reader has checked every index and array length; what is left is the cell shape.
+    if data.cell_types.iter().any(|&t| t != spatter_io::vtk::cell_type::TRIANGLE) {
         return Err(format!("{}: not a mesh of triangles only", vtu.display()));
     }
-    let n_points = data.points.len() as i64;
-    if data.connectivity.iter().any(|&i| i < 0 || i >= n_points) {
-        return Err(format!("{}: a triangle names a point that does not exist", vtu.display()));
-    }
-    let triangles =
-        data.connectivity.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
-    let values = match data.cell_data.get(array) {
-        Some((1, v)) => v.clone(),
-        Some((n, _)) => {
-            return Err(format!("{}: cell array `{array}` has {n} components, expected 1", vtu.display()))
+    let triangles = data.connectivity.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let values = match data.cell_array(array) {
+        Some(a) if a.components == 1 => a.values.clone(),
+        Some(a) => {
+            return Err(format!(
+                "{}: cell array `{array}` has {} components, expected 1",
+                vtu.display(),
+                a.components
+            ))
         }
         None => return Err(format!("{}: no cell array `{array}`", vtu.display())),
     };

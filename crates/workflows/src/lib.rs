@@ -6,6 +6,7 @@ pub mod brownout;
 pub mod cfd;
 pub mod dem_scene;
 pub mod deposition;
+pub mod fluid_forces;
 pub mod snow;
 pub mod sph_scene;
 pub mod wading;

@@ -73,7 +73,7 @@ fn a_run_writes_every_output() {
     let (cols, rows) = spatter_io::csv::read_series(&tmp.path().join("series.csv")).unwrap();
     assert!(cols.iter().any(|c| c == "far_p_Pa") && cols.iter().any(|c| c == "tank_Fz_N"));
     assert!(rows.len() >= 25, "a row every 2 ms: {}", rows.len());
-    let vtu = spatter_io::vtu::read(&tmp.path().join("particles/particles_00005.vtu")).unwrap();
+    let vtu = spatter_io::vtk::read(&tmp.path().join("particles/particles_00005.vtu")).unwrap();
     assert_eq!(vtu.points.len(), 10 * 20);
     // The log is the job driver's (one tracing path); the scene writes no log.txt of its own.
     assert!(!tmp.path().join("log.txt").exists(), "the scene writes no log.txt itself");
@@ -460,8 +460,8 @@ fn wet_time_is_the_time_under_water() {
     assert!((f - 1.0).abs() < 1e-12, "fixed block under water: wet fraction {f}");
 
     // Wall particles at the end (walls/…: position, normal, area, part, wet_time_s).
-    let w = spatter_io::vtu::read(&tmp.path().join("walls/walls_00001.vtu")).unwrap();
-    let get = |name: &str| &w.point_data[name].1;
+    let w = spatter_io::vtk::read(&tmp.path().join("walls/walls_00001.vtu")).unwrap();
+    let get = |name: &str| &w.point_array(name).unwrap().values;
     let (part, nrm, area, wet) = (get("part"), get("normal"), get("area_m2"), get("wet_time_s"));
     let (mut submerged, mut arriving) = (0, 0);
     for (i, x) in w.points.iter().enumerate() {

@@ -1,8 +1,8 @@
 //! Cell faces of the VTK cell types and the decomposition of a [`VtkDataset`] into a conforming
 //! tetrahedral mesh (see [`super::tetmesh`] for the rule).
 
-use crate::vtk::{cell_type as ct, VtkDataset};
 use spatter_core::Vec3;
+use spatter_io::vtk::{cell_type as ct, VtkDataset};
 
 /// Face lists (local vertex ids) of the linear VTK cells (VTK `vtkTetra`, `vtkHexahedron`, `vtkWedge`,
 /// `vtkPyramid` face tables). Orientation does not matter here.

@@ -18,9 +18,9 @@
 use super::decompose::{decompose, CentreRule};
 use super::tetmesh::TetMesh;
 use super::{FieldError, FlowField, Sample};
-use crate::vtk::{self, DataArray, VtkDataset};
 use serde::{Deserialize, Serialize};
 use spatter_core::{Aabb, Mat3, Vec3};
+use spatter_io::vtk::{self, DataArray, VtkDataset};
 use std::path::{Path, PathBuf};
 
 /// How values between mesh points are obtained.
@@ -587,7 +587,7 @@ impl FlowField for ImportedField {
 mod tests {
     use super::*;
     use crate::field::tetmesh::{kuhn_box, NONE};
-    use crate::vtk::cell_type as ct;
+    use spatter_io::vtk::cell_type as ct;
 
     fn lin(p: Vec3) -> Vec3 {
         Vec3::new(1.0 + 2.0 * p.x - p.y + 0.5 * p.z, -3.0 * p.x + 0.25 * p.y, 0.7 - p.z + 4.0 * p.y)
@@ -781,7 +781,7 @@ VECTORS U double
 
     #[test]
     fn legacy_structured_grid_is_read_and_a_linear_field_reproduced_exactly() {
-        let ds = crate::vtk::legacy::parse(STRUCTURED_GRID.as_bytes(), Path::new("s.vtk")).unwrap();
+        let ds = spatter_io::vtk::legacy::parse(STRUCTURED_GRID.as_bytes(), Path::new("s.vtk")).unwrap();
         ds.check(Path::new("s.vtk")).unwrap();
         // Points in file order (i fastest), two hexahedra in VTK's vertex order, cell data kept.
         assert_eq!(ds.points.len(), 12);
@@ -804,7 +804,7 @@ VECTORS U double
 
     #[test]
     fn legacy_rectilinear_grid_ascii_and_binary_reproduce_a_linear_field_exactly() {
-        let ds = crate::vtk::legacy::parse(RECTILINEAR_GRID.as_bytes(), Path::new("r.vtk")).unwrap();
+        let ds = spatter_io::vtk::legacy::parse(RECTILINEAR_GRID.as_bytes(), Path::new("r.vtk")).unwrap();
         assert_eq!(ds.points.len(), 12);
         assert_eq!(ds.points[1], Vec3::new(0.3, -1.0, 2.0));
         assert_eq!(ds.points[5], Vec3::new(1.0, 0.5, 2.0));
@@ -835,7 +835,7 @@ VECTORS U double
                 b.extend_from_slice(&c.to_be_bytes());
             }
         }
-        let bin = crate::vtk::legacy::parse(&b, Path::new("rb.vtk")).unwrap();
+        let bin = spatter_io::vtk::legacy::parse(&b, Path::new("rb.vtk")).unwrap();
         assert_eq!(bin.points, pts.collect::<Vec<_>>());
         let f = load_text("rb.vtk", &b);
         assert_linear_exact(&f);

@@ -87,7 +87,7 @@ impl<T: FlowField> FlowField for &T {
 #[derive(Debug, Error)]
 pub enum FieldError {
     #[error(transparent)]
-    Vtk(#[from] crate::vtk::VtkError),
+    Vtk(#[from] spatter_io::vtk::VtkError),
     #[error("flow field {path}: {message}")]
     Data { path: PathBuf, message: String },
     #[error("flow field: {0}")]

@@ -146,12 +146,13 @@ fn max_speed(flow: &Flow) -> f64 {
     m
 }
 
-fn probe_row(cfg: &FlowConfig, flow: &Flow) -> Vec<f64> {
-    let mut row = vec![flow.state.t];
+/// One row of the probe table; a probe in a blocked cell is a gap (`None`).
+fn probe_row(cfg: &FlowConfig, flow: &Flow) -> Vec<Option<f64>> {
+    let mut row = vec![Some(flow.state.t)];
     for p in &cfg.output.probes {
         match probe(flow, p.at_m) {
-            Some((u, pr)) => row.extend([u[0], u[1], u[2], pr]),
-            None => row.extend([f64::NAN; 4]),
+            Some((u, pr)) => row.extend([u[0], u[1], u[2], pr].map(Some)),
+            None => row.extend([None; 4]),
         }
     }
     row
@@ -244,7 +245,7 @@ pub fn run(cfg: &FlowConfig, ctx: &RunContext) -> Result<RunSummary, FlowRunErro
                 flow.net_outflow(),
             ];
             series.row(&row).map_err(io_at(&series_path))?;
-            probes.row(&probe_row(cfg, &flow)).map_err(io_at(&probes_path))?;
+            probes.row_with_gaps(&probe_row(cfg, &flow)).map_err(io_at(&probes_path))?;
             if let Some(limit) = cfg.time.steady_rate_m_s2 {
                 if let Some(prev) = &st.previous {
                     let change = (0..3)

@@ -222,31 +222,35 @@ impl EventLog {
     }
 
     /// Rows of `events.csv`: one per body or sphere that hit a wall or was checked against the crossing
-    /// plane, bodies first, by id; NaN where an event did not happen (the wall index is −1 then).
-    pub fn rows(&self) -> Vec<Vec<f64>> {
-        let nan = f64::NAN;
+    /// plane, bodies first, by id; a gap (`None`, an empty cell) where an event did not happen (the wall
+    /// index is −1 then) and for the in-plane angle of an impact whose velocity is normal to that plane.
+    pub fn rows(&self) -> Vec<Vec<Option<f64>>> {
         let mut keys: Vec<&Key> = self.records.keys().collect();
         keys.sort_by_key(|k| (!k.0, k.1));
         keys.into_iter()
             .map(|k| {
                 let r = &self.records[k];
-                let mut row = vec![k.0 as u8 as f64, k.1 as f64, r.template as f64];
+                let mut row: Vec<Option<f64>> =
+                    vec![Some(k.0 as u8 as f64), Some(k.1 as f64), Some(r.template as f64)];
                 match &r.first {
                     Some(f) => row.extend([
-                        f.t,
-                        f.wall as f64,
-                        f.triangle.map_or(-1.0, |t| t as f64),
-                        f.speed,
-                        f.normal_speed,
-                        f.angle_deg,
-                        f.plane_angle_deg,
+                        Some(f.t),
+                        Some(f.wall as f64),
+                        Some(f.triangle.map_or(-1.0, |t| t as f64)),
+                        Some(f.speed),
+                        Some(f.normal_speed),
+                        Some(f.angle_deg),
+                        // NaN by design when the velocity has no component in the plane.
+                        Some(f.plane_angle_deg).filter(|a| !a.is_nan()),
                     ]),
-                    None => row.extend([nan, -1.0, -1.0, nan, nan, nan, nan]),
+                    None => row.extend([None, Some(-1.0), Some(-1.0), None, None, None, None]),
                 }
-                row.extend(r.collisions.iter().map(|&c| c as f64));
+                row.extend(r.collisions.iter().map(|&c| Some(c as f64)));
                 match &r.crossing {
-                    Some(c) => row.extend([c.t, c.pos.x, c.pos.y, c.pos.z, c.dir.x, c.dir.y, c.dir.z]),
-                    None => row.extend([nan; 7]),
+                    Some(c) => {
+                        row.extend([c.t, c.pos.x, c.pos.y, c.pos.z, c.dir.x, c.dir.y, c.dir.z].map(Some))
+                    }
+                    None => row.extend([None; 7]),
                 }
                 row
             })

@@ -491,7 +491,7 @@ fn write_events<L: ContactLaw>(
     let names: Vec<String> = sim.walls.iter().map(|w| w.name.clone()).collect();
     let mut csv = series(&path, &EventLog::columns(&names), None)?;
     for row in log.rows() {
-        csv.row(&row).map_err(|source| DemError::Io { path: path.clone(), source })?;
+        csv.row_with_gaps(&row).map_err(|source| DemError::Io { path: path.clone(), source })?;
     }
     csv.flush().map_err(|source| DemError::Io { path: path.clone(), source })
 }

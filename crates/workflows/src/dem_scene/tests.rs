@@ -125,8 +125,8 @@ fn interrupted_and_resumed_run_equals_uninterrupted_run_bit_for_bit() {
     let last: Vec<f64> = csv.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
     let first: Vec<f64> = csv.lines().nth(1).unwrap().split(',').map(|x| x.parse().unwrap()).collect();
     assert!(last[2] > first[2], "injection added particles: {} → {}", first[2], last[2]);
-    let mesh = spatter_io::vtu::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
-    let impacts = &mesh.cell_data["impacts"].1;
+    let mesh = spatter_io::vtk::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
+    let impacts = &mesh.cell_array("impacts").unwrap().values;
     assert!(impacts.iter().sum::<f64>() > 0.0, "impacts recorded on the STL floor");
 }
 
@@ -463,8 +463,9 @@ shape = { type = "rectangle", center_m = [0.05, 0, 0], half_u_m = [0.03, 0, 0], 
     let dir = RunDir::create(&tmp.path().join("run")).unwrap();
     let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap();
     assert_eq!(s.finished, Finished::Completed);
-    let vtu = spatter_io::vtu::read(&dir.root().join("particles/particles_00001.vtu")).unwrap();
-    let (ids, vel) = (&vtu.point_data["id"].1, &vtu.point_data["velocity_m_s"].1);
+    let vtu = spatter_io::vtk::read(&dir.root().join("particles/particles_00001.vtu")).unwrap();
+    let (ids, vel) =
+        (&vtu.point_array("id").unwrap().values, &vtu.point_array("velocity_m_s").unwrap().values);
     let x = &vtu.points;
     let mut e = [0.0; 2];
     for k in 0..ids.len() {
@@ -620,8 +621,8 @@ fn a_stone_scene_runs_resumes_bit_for_bit_and_reports_its_wear() {
     let injected = scalar(&s, "injected_mass_kg").unwrap();
     assert!((injected - 0.05 * 0.035).abs() <= 0.5 * 3.15e-4, "injected {injected} kg");
     // Every member sphere in the particle VTU carries its body id; bodies.csv has one row per body.
-    let vtu = spatter_io::vtu::read(&full.root().join("particles/particles_00004.vtu")).unwrap();
-    let ids = &vtu.point_data["body_id"].1;
+    let vtu = spatter_io::vtk::read(&full.root().join("particles/particles_00004.vtu")).unwrap();
+    let ids = &vtu.point_array("body_id").unwrap().values;
     assert!(ids.iter().all(|&b| b >= 0.0), "only members, no free spheres");
     let mut distinct: Vec<i64> = ids.iter().map(|&b| b as i64).collect();
     distinct.sort();
@@ -639,8 +640,8 @@ fn a_stone_scene_runs_resumes_bit_for_bit_and_reports_its_wear() {
     assert!(wear.starts_with("t_s,floor_eroded_mass_kg,floor_impacts"), "{wear}");
     let last: Vec<f64> = wear.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
     assert_eq!(last[1], total);
-    let mesh = spatter_io::vtu::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
-    let per_triangle: f64 = mesh.cell_data["eroded_mass_kg"].1.iter().sum();
+    let mesh = spatter_io::vtk::read(&full.root().join("walls/floor_00004.vtu")).unwrap();
+    let per_triangle: f64 = mesh.cell_array("eroded_mass_kg").unwrap().values.iter().sum();
     assert!((per_triangle - total).abs() <= 1e-12 * total, "{per_triangle} vs {total}");
     assert!(full.root().join("wear/floor_eroded_mass.png").is_file());
     assert!(full.root().join("templates/pebble.vtu").is_file());
@@ -701,12 +702,9 @@ first = 1
     )
 }
 
+/// Header and rows of a CSV the scene wrote; an empty cell (an event that did not happen) reads as NaN.
 fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let head = lines.next().unwrap().split(',').map(str::to_owned).collect();
-    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
-    (head, rows)
+    spatter_io::csv::read_series(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 #[test]
@@ -739,8 +737,8 @@ fn the_event_log_records_first_impacts_and_plane_crossings_and_resumes() {
     // along x: v_z² = 1 + 2 g h, so the impact angle is atan(|v_z|/1) ≈ 54° (to 0.02°: the event takes
     // the half-step velocity, g Δt/2 = 5e-5 m/s, of the step in which the contact formed); in the x–z
     // plane the same angle (the velocity lies in it).
-    let first = spatter_io::vtu::read(&full.root().join("particles/particles_00000.vtu")).unwrap();
-    let free = first.point_data["body_id"].1.iter().position(|&b| b < 0.0).unwrap();
+    let first = spatter_io::vtk::read(&full.root().join("particles/particles_00000.vtu")).unwrap();
+    let free = first.point_array("body_id").unwrap().values.iter().position(|&b| b < 0.0).unwrap();
     let h = first.points[free].z - 0.002;
     let vz = (1.0 + 2.0 * 9.81 * h).sqrt();
     let angle = vz.atan().to_degrees();

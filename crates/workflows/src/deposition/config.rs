@@ -211,7 +211,7 @@ impl Validate for FlowSpec {
             if !full.is_file() {
                 c.file_exists("series", p);
             } else {
-                match spatter_flow::vtk::series::read_series(&full) {
+                match spatter_io::vtk::series::read_series(&full) {
                     Err(e) => c.fail("series", format!("series = \"{}\": {e}", p.display())),
                     // The first snapshot is read in full; the others when the run reaches them.
                     Ok(list) => match list.first() {
@@ -260,7 +260,7 @@ fn vtk_file(c: &mut Checker, key: &str, path: &Path) {
     if !full.is_file() {
         return c.file_exists(key, path);
     }
-    if let Err(e) = spatter_flow::vtk::read(&full) {
+    if let Err(e) = spatter_io::vtk::read(&full) {
         c.fail(key, format!("{key} = \"{}\": {e}", path.display()));
     }
 }

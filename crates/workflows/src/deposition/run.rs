@@ -85,7 +85,7 @@ pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
     let files: Vec<(f64, PathBuf)> = if let Some(v) = &f.vtk {
         vec![(0.0, cfg.resolve(v))]
     } else if let Some(s) = &f.series {
-        spatter_flow::vtk::series::read_series(&cfg.resolve(s)).map_err(FieldError::from)?
+        spatter_io::vtk::series::read_series(&cfg.resolve(s)).map_err(FieldError::from)?
     } else {
         f.files.iter().map(|t| (t.time_s, cfg.resolve(&t.file))).collect()
     };

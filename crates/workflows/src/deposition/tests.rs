@@ -113,12 +113,12 @@ fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
     assert!(b.join("plate_deposit.png").is_file() && b.join("deposit_summary.csv").is_file());
     assert!(s.headline.iter().any(|l| l.contains("PARTIAL") && l.contains("--resume")), "{:?}", s.headline);
     let ck: super::run::Checkpoint = spatter_io::checkpoint::load(&b.join("checkpoint.bin"), 0).unwrap();
-    let vtu = spatter_io::vtu::read(&b.join("bodies/plate.vtu")).unwrap();
-    let partial_mass: f64 = vtu.cell_data["deposited_mass_kg"].1.iter().sum();
+    let vtu = spatter_io::vtk::read(&b.join("bodies/plate.vtu")).unwrap();
+    let partial_mass: f64 = vtu.cell_array("deposited_mass_kg").unwrap().values.iter().sum();
     let exact = ck.state.balance.deposited.value();
     assert!(exact > 0.0, "nothing deposited before the interrupt: pick a later one");
     assert!((partial_mass - exact).abs() <= 1e-12 * exact, "{partial_mass} vs {exact}");
-    let partial_impacts: f64 = vtu.cell_data["impacts"].1.iter().sum();
+    let partial_impacts: f64 = vtu.cell_array("impacts").unwrap().values.iter().sum();
     assert_eq!(partial_impacts, ck.state.deposits[0].impacts.iter().sum::<u64>() as f64);
     let s = run_in(&cfg, &b, &StopAfterPolls::new(100), true);
     assert_eq!(s.finished, spatter_core::control::Finished::Interrupted, "stopped twice");
@@ -140,9 +140,9 @@ fn interrupted_and_resumed_run_equals_an_uninterrupted_one() {
     }
     assert!(!b.join("checkpoint.bin").exists());
     // Something stuck and something bounced: the plate saw more impacts than parcels stuck to it.
-    let vtu = spatter_io::vtu::read(&a.join("bodies/plate.vtu")).unwrap();
-    let impacts: f64 = vtu.cell_data["impacts"].1.iter().sum();
-    let deposited_mass: f64 = vtu.cell_data["deposited_mass_kg"].1.iter().sum();
+    let vtu = spatter_io::vtk::read(&a.join("bodies/plate.vtu")).unwrap();
+    let impacts: f64 = vtu.cell_array("impacts").unwrap().values.iter().sum();
+    let deposited_mass: f64 = vtu.cell_array("deposited_mass_kg").unwrap().values.iter().sum();
     let balance = std::fs::read_to_string(a.join("balance.csv")).unwrap();
     let last: Vec<f64> = balance.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
     let stuck_parcels = last[2];
@@ -246,8 +246,8 @@ fn wall_lift_key_uses_the_wall_shear_estimate_and_changes_the_run_only_when_on()
     let (out_off, out_on) = (dir.path().join("off"), dir.path().join("on"));
     run_in(&cfg, &out_off, &Unattended, false);
     run_in(&on, &out_on, &Unattended, false);
-    let vtu = spatter_io::vtu::read(&out_on.join("bodies/plate.vtu")).unwrap();
-    let tau = &vtu.cell_data["wall_shear_estimate_pa"].1;
+    let vtu = spatter_io::vtk::read(&out_on.join("bodies/plate.vtu")).unwrap();
+    let tau = &vtu.cell_array("wall_shear_estimate_pa").unwrap().values;
     let mut plate = TriMesh::rectangle(1.0, 1.0, 0.0, 8, 8);
     plate.map_vertices(|v| v - Vec3::new(0.5, 0.5, 0.0));
     assert_eq!(tau.len(), plate.triangles.len());
@@ -256,8 +256,8 @@ fn wall_lift_key_uses_the_wall_shear_estimate_and_changes_the_run_only_when_on()
         let expect = mu * (3.0 + a * plate.centroid(t).x).abs() / h;
         assert!((got - expect).abs() <= 1e-12 * expect, "triangle {t}: {got} vs {expect}");
     }
-    let vtu_off = spatter_io::vtu::read(&out_off.join("bodies/plate.vtu")).unwrap();
-    assert!(vtu_off.cell_data["wall_shear_estimate_pa"].1.iter().all(|&v| v == 0.0));
+    let vtu_off = spatter_io::vtk::read(&out_off.join("bodies/plate.vtu")).unwrap();
+    assert!(vtu_off.cell_array("wall_shear_estimate_pa").unwrap().values.iter().all(|&v| v == 0.0));
     let balance = |d: &Path| std::fs::read_to_string(d.join("balance.csv")).unwrap();
     assert_ne!(balance(&out_off), balance(&out_on), "the lift changed no trajectory");
     // The same run without the key again gives the same file: the switch is the only difference.

@@ -241,8 +241,8 @@ struct Loads {
 pub struct TracePoint {
     /// Time since first touch \[s\].
     pub t: f64,
-    /// Largest overlap of an active contact \[m\] (NaN without contact).
-    pub overlap: f64,
+    /// Largest overlap of an active contact \[m\] (`None` without contact).
+    pub overlap: Option<f64>,
     /// Sum of the signed normal contact forces on the particle \[N\] (positive repulsive).
     pub normal_force: f64,
     /// Particle centre \[m\] and velocity \[m/s\] (relative to a free partner).
@@ -433,7 +433,7 @@ pub fn run_impact<L: ContactLaw>(
         if let Some(tr) = trace.as_deref_mut() {
             tr.push(TracePoint {
                 t,
-                overlap: if n > 0 { l.active_overlap } else { f64::NAN },
+                overlap: (n > 0).then_some(l.active_overlap),
                 normal_force: l.normal_force,
                 position: (b.x - b.xp).to_array(),
                 velocity: (b.v - b.vp).to_array(),

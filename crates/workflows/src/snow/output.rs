@@ -206,7 +206,18 @@ pub fn write_critical_speeds(path: &Path, speeds: &[CriticalSpeed]) -> io::Resul
             BracketStatus::BelowRange => -1.0,
             BracketStatus::AboveRange => 1.0,
         };
-        csv.row(&[c.diameter, c.v_crit, c.low, c.high, status, c.impacts as f64, c.energy_created as f64])?;
+        // Outside the bracket the critical speed (and, above it, the lowest bounce) is undefined: a gap.
+        let found = c.status == BracketStatus::Found;
+        let above = c.status == BracketStatus::AboveRange;
+        csv.row_with_gaps(&[
+            Some(c.diameter),
+            found.then_some(c.v_crit),
+            Some(c.low),
+            (!above).then_some(c.high),
+            Some(status),
+            Some(c.impacts as f64),
+            Some(c.energy_created as f64),
+        ])?;
     }
     csv.flush()
 }

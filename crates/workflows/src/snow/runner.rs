@@ -552,16 +552,17 @@ fn run_sensitivity(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary,
         // The baseline is drawn last so that cases on top of it do not hide it.
         lines.push((label, pts, output::case_colour(c)));
         let cc = case_config(cfg, case);
+        // The yield stress is undefined for a constant restitution: an empty cell.
         let sy = match cc.contact.restitution {
-            RestitutionModel::Thornton { yield_stress_pa, .. } => yield_stress_pa,
-            RestitutionModel::Constant { .. } => f64::NAN,
+            RestitutionModel::Thornton { yield_stress_pa, .. } => format!("{yield_stress_pa}"),
+            RestitutionModel::Constant { .. } => String::new(),
         };
         rows.push(vec![
             case.name.clone(),
             format!("{}", cc.particle.youngs_modulus),
             format!("{}", cc.particle.poisson_ratio),
             format!("{}", cc.contact.work_of_adhesion_j_m2),
-            format!("{sy}"),
+            sy,
             format!("{count}"),
             case.thesis_sticks.map_or(String::new(), |t| t.to_string()),
             format!("{}", recs.len()),
@@ -813,15 +814,16 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
         &["t_s", "overlap_m", "normal_force_N", "x_m", "z_m", "vx_m_s", "vz_m_s", "contacts"],
     )?;
     for p in &trace {
-        csv.row(&[
-            p.t,
+        // Without contact the overlap is undefined: an empty cell.
+        csv.row_with_gaps(&[
+            Some(p.t),
             p.overlap,
-            p.normal_force,
-            p.position[0],
-            p.position[2],
-            p.velocity[0],
-            p.velocity[2],
-            p.contacts as f64,
+            Some(p.normal_force),
+            Some(p.position[0]),
+            Some(p.position[2]),
+            Some(p.velocity[0]),
+            Some(p.velocity[2]),
+            Some(p.contacts as f64),
         ])?;
     }
     csv.flush()?;
@@ -834,11 +836,8 @@ fn run_single(cfg: &SnowConfig, ctx: &RunContext<'_>) -> Result<RunSummary, Snow
         Some(j) => (j.pull_off_force, j.critical_overlap, "overlap / δ_c", "normal force / F_c"),
         None => (1.0, 1.0, "overlap [m]", "normal force [N]"),
     };
-    let pts: Vec<(f64, f64)> = trace
-        .iter()
-        .filter(|p| p.overlap.is_finite())
-        .map(|p| (p.overlap / ds, p.normal_force / fs))
-        .collect();
+    let pts: Vec<(f64, f64)> =
+        trace.iter().filter_map(|p| p.overlap.map(|o| (o / ds, p.normal_force / fs))).collect();
     let mut chart = Chart::new(
         &format!(
             "Force–overlap history: {} µm grain at {} m/s ({:?})",

@@ -43,7 +43,7 @@ pub fn write_sample_impacts(
                 .point_scalar("radius_m", &[0.5 * d])
                 .point_vector("velocity_m_s", &[Vec3::from_array(p.velocity)])
                 .point_scalar("normal_force_N", &[p.normal_force])
-                .point_scalar("overlap_m", &[if p.overlap.is_finite() { p.overlap } else { 0.0 }])
+                .point_scalar("overlap_m", &[p.overlap.unwrap_or(0.0)])
                 .write(&dir.path(&format!("samples/{name}")))?;
             pvd.push(p.t, &name)?;
         }

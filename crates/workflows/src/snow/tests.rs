@@ -650,14 +650,13 @@ fn sample_impacts_write_the_target_they_hit() {
         assert!(arts.iter().any(|(_, p)| *p == path), "{target:?}: {arts:?}");
         let other = if file == "wall.vtu" { "target_sphere.vtu" } else { "wall.vtu" };
         assert!(!dir.root().join("samples").join(other).exists(), "{target:?}: no {other}");
-        let data = spatter_io::vtu::read(&path).unwrap();
+        let data = spatter_io::vtk::read(&path).unwrap();
         match target {
             TargetKind::Wall => assert!(data.points.iter().all(|p| p.z == 0.0)),
             _ => {
                 let radius = partner.unwrap_or(10e-6) / 2.0;
                 assert!(data.points.iter().all(|p| (p.length() / radius - 1.0).abs() < 1e-12), "{target:?}");
-                let tris: Vec<[u32; 3]> =
-                    data.connectivity.chunks(3).map(|c| [c[0] as u32, c[1] as u32, c[2] as u32]).collect();
+                let tris: Vec<[u32; 3]> = data.connectivity.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
                 let mesh = TriMesh { vertices: data.points.clone(), triangles: tris };
                 let v = mesh.signed_volume();
                 let exact = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
@@ -672,10 +671,10 @@ fn sample_impacts_write_the_target_they_hit() {
     let index = super::bed_index::BedIndex::new(&bed.spheres);
     let dir = RunDir::create(&root.path().join("bed")).unwrap();
     write_sample_impacts(&model_of(&cfg), Surface::bed(&bed, &index), &[(10e-6, 0.5, "a")], &dir).unwrap();
-    let data = spatter_io::vtu::read(&dir.root().join("samples/bed.vtu")).unwrap();
+    let data = spatter_io::vtk::read(&dir.root().join("samples/bed.vtu")).unwrap();
     assert_eq!(data.points.len(), bed.spheres.len());
     assert_eq!(data.points[3], Vec3::from(bed.spheres[3].centre));
-    assert!(data.point_data["radius_m"].1.iter().all(|&r| r == 0.5e-6));
+    assert!(data.point_array("radius_m").unwrap().values.iter().all(|&r| r == 0.5e-6));
 }
 
 #[test]

@@ -70,9 +70,10 @@ fn series_columns(cfg: &SphConfig, sim: &Simulation) -> Vec<String> {
     c
 }
 
-fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<f64> {
+/// One row of `series.csv`; a probe without fluid around it is a gap (`None`).
+fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<Option<f64>> {
     let l = sim.last;
-    let mut r = vec![
+    let mut r: Vec<Option<f64>> = [
         sim.time,
         sim.dt,
         sim.steps as f64,
@@ -86,20 +87,24 @@ fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<f64> {
         l.guard_hits as f64,
         l.dt_acoustic,
         l.dt_force,
-    ];
+    ]
+    .map(Some)
+    .to_vec();
     let loads = sim.part_loads();
     for (k, ld) in loads.iter().enumerate() {
         let wa = wet_area(sim, k, sim.time);
-        r.extend([ld.force.x, ld.force.y, ld.force.z, ld.torque.x, ld.torque.y, ld.torque.z, wa.wet_now]);
+        r.extend(
+            [ld.force.x, ld.force.y, ld.force.z, ld.torque.x, ld.torque.y, ld.torque.z, wa.wet_now].map(Some),
+        );
     }
     for p in &cfg.sensors.probes {
         match sim.probe(p.position_m) {
-            Some((pr, v)) => r.extend([pr, v.x, v.y, v.z]),
-            None => r.extend([f64::NAN; 4]),
+            Some((pr, v)) => r.extend([pr, v.x, v.y, v.z].map(Some)),
+            None => r.extend([None; 4]),
         }
     }
     for p in &cfg.sensors.wall_probes {
-        r.push(sim.wall_pressure(p.position_m, p.radius_m).unwrap_or(f64::NAN));
+        r.push(sim.wall_pressure(p.position_m, p.radius_m));
     }
     r
 }
@@ -215,7 +220,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
         // Outputs due at the current time.
         if st.sim.time >= st.next_sample - 1e-12 * end {
             let row = series_row(cfg, &mut st.sim);
-            series.row(&row).map_err(io_at(&series_path))?;
+            series.row_with_gaps(&row).map_err(io_at(&series_path))?;
             while st.next_sample <= st.sim.time + 1e-12 * end {
                 st.next_sample += sample_dt;
             }

@@ -411,6 +411,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<VtkDataset, VtkError> {
                 let pts = piece.child("Points").and_then(|p| p.children_named("DataArray").next());
                 let pts = pts.ok_or_else(|| VtkError::format(path, "Piece without <Points>"))?;
                 let v = array_values(pts, enc, &appended, path)?;
+                if v.len() % 3 != 0 {
+                    return Err(VtkError::format(path, format!("<Points> holds {} values, not a multiple of 3", v.len())));
+                }
                 part.points = v.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
                 let cells = piece.child("Cells").ok_or_else(|| VtkError::format(path, "Piece without <Cells>"))?;
                 let get = |n: &str| -> Result<Option<Vec<i64>>, VtkError> {
@@ -431,6 +434,14 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<VtkDataset, VtkError> {
                     return Err(VtkError::format(path, "cell offsets are not increasing or do not end at the connectivity size"));
                 }
                 part.connectivity = conn.iter().map(|&i| i as u32).collect();
+                // The piece's declared sizes must agree with its arrays (a truncated or edited file).
+                for (key, found) in [("NumberOfPoints", part.points.len()), ("NumberOfCells", part.cell_types.len())] {
+                    if let Some(declared) = piece.attr(key) {
+                        if declared.trim().parse::<usize>().ok() != Some(found) {
+                            return Err(VtkError::format(path, format!("Piece says {key}=\"{declared}\" but its arrays hold {found}")));
+                        }
+                    }
+                }
                 if part.cell_types.contains(&cell_type::POLYHEDRON) {
                     part.poly_faces = polyhedra(&get("faces")?, &get("faceoffsets")?, &get("face_connectivity")?, &get("face_offsets")?, &get("polyhedron_to_faces")?, &get("polyhedron_offsets")?, &part.cell_types, path)?;
                 }
@@ -491,9 +502,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<VtkDataset, VtkError> {
         part.check(path)?;
         merge(&mut ds, part, base);
     }
-    if ds.points.is_empty() {
-        return Err(VtkError::format(path, "the file holds no points"));
-    }
+    // A file without points is valid VTK (a particle snapshot after the last particle left); whoever needs
+    // cells says so (the flow-field import refuses a file without volume cells).
     Ok(ds)
 }
 
