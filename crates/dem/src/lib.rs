@@ -8,6 +8,7 @@ pub mod clump;
 pub mod contact;
 pub mod error;
 pub mod insertion;
+pub mod integrators;
 pub mod output;
 pub mod par;
 pub mod particles;

@@ -443,6 +443,7 @@ mod tests {
                 normal: Vec3::Z,
                 overlap: -gap,
                 r_eff,
+                radius_sum: r_eff,
                 m_eff,
                 i_eff: 0.4 * m_eff * r_eff * r_eff,
                 v_rel: Vec3::new(0.0, 0.0, v),

@@ -86,6 +86,8 @@ kinds! {
         "Stone-chip test (DIN 55996-1, SAE J400): stones shot through a pipe at a coated panel; damage map, strip shares, impact statistics.";
     "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
         "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";
+    "integrator_study" => IntegratorStudy(spatter_workflows::bed_lab::IntegratorStudyConfig, spatter_workflows::bed_lab::run_integrator_study),
+        "The ten DEM time integrators on analytic single contacts: error sweeps, observed orders beside Jasion (2013).";
 }
 
 #[allow(dead_code)]

@@ -249,6 +249,7 @@ mod tests {
             normal: Vec3::Z,
             overlap,
             r_eff: r,
+            radius_sum: r,
             m_eff: 1e-12,
             i_eff: 1e-24,
             v_rel: Vec3::ZERO,

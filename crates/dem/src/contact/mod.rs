@@ -71,6 +71,7 @@
 //! Then use it as `Composed<MyLaw, RestitutionDamping, Mindlin, NoRolling>`. The engine, walls, meshes,
 //! history bookkeeping and checkpoints need no change.
 
+mod cohesion;
 mod composed;
 mod damping;
 mod normal;
@@ -79,6 +80,7 @@ pub mod restitution_fit;
 mod rolling;
 mod tangential;
 
+pub use cohesion::{LinearCohesion, LinearCohesionParams};
 pub use composed::{Composed, ComposedParams, ComposedState, CoulombLoad};
 pub use damping::{
     DampingLaw, NoDamping, RestitutionCalibration, RestitutionDamping, RestitutionDampingParams,
@@ -105,6 +107,9 @@ pub struct ContactInput {
     pub overlap: f64,
     /// Effective radius R* \[m\] (R for a flat wall).
     pub r_eff: f64,
+    /// Sum of the radii rᵢ + rⱼ \[m\] (rᵢ for a wall), from which range-based laws such as
+    /// [`LinearCohesion`] scale their reach.
+    pub radius_sum: f64,
     /// Effective mass m* \[kg\] (m for a wall or frozen partner).
     pub m_eff: f64,
     /// Effective moment of inertia 1/(1/Iᵢ + 1/Iⱼ) \[kg m²\], for rolling laws that must not overshoot.

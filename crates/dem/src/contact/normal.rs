@@ -99,8 +99,10 @@ impl NormalLaw for Hooke {
     type Params = HookeParams;
     type State = ();
 
+    /// The pair's own stiffness ([`PairProps::stiffness`]) wins over the law's global choice.
     fn params(&self, _pair_index: usize, props: &PairProps) -> HookeParams {
-        HookeParams { e_star: props.e_star, stiffness: self.stiffness }
+        let stiffness = props.stiffness.map_or(self.stiffness, HookeStiffness::Constant);
+        HookeParams { e_star: props.e_star, stiffness }
     }
 
     #[inline(always)]

@@ -28,6 +28,15 @@ pub struct PairProps {
     /// `None` lets that law use its own model. [`super::RestitutionDamping`] always uses the constant
     /// `restitution`.
     pub restitution_model: Option<crate::restitution_models::RestitutionModel>,
+    /// Linear (Hooke) normal stiffness k_n of this pair \[N/m\], overriding the law's global choice
+    /// (`None` = the law's own stiffness). A particle–wall pair carries the wall stiffness this way
+    /// (Jasion 2013, Appendix C: k_wall = 24 k_n).
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// Linear cohesion stiffness k_coh ≥ 0 \[N/m\] of [`super::LinearCohesion`] (0 = no cohesion): the
+    /// attractive force k_coh·δ_coh acts while the cohesion radii overlap by δ_coh.
+    #[serde(default)]
+    pub cohesion_stiffness: f64,
 }
 
 impl PairProps {
@@ -43,6 +52,8 @@ impl PairProps {
             restitution,
             work_of_adhesion: 0.0,
             restitution_model: None,
+            stiffness: None,
+            cohesion_stiffness: 0.0,
         }
     }
 }

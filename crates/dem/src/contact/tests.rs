@@ -10,6 +10,7 @@ fn input(overlap: f64, v_rel: Vec3, r_eff: f64, m_eff: f64, dt: f64) -> ContactI
         normal: Vec3::Z,
         overlap,
         r_eff,
+        radius_sum: r_eff,
         m_eff,
         i_eff: 0.4 * m_eff * r_eff * r_eff,
         v_rel,

@@ -102,6 +102,21 @@ impl<L: ContactLaw> Simulation<L> {
         v2max.0.sqrt()
     }
 
+    /// Sets the spins of all single spheres to zero (rotation switched off; clump members take their
+    /// spin from their body and keep it).
+    pub(crate) fn clear_spins(&mut self) {
+        let p = &mut self.particles;
+        if self.st.bodies.is_empty() {
+            p.omega.par_iter_mut().for_each(|w| *w = Vec3::ZERO);
+        } else {
+            for i in 0..p.len() {
+                if !p.is_member(i) {
+                    p.omega[i] = Vec3::ZERO;
+                }
+            }
+        }
+    }
+
     /// Fails with a blow-up error naming the first particle whose state is not finite (the kicks flag a
     /// non-finite state as they go; only then are the particles searched).
     pub(crate) fn check_finite(&mut self) -> Result<(), DemError> {

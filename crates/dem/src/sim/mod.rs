@@ -51,6 +51,15 @@ pub struct Settings {
     /// The mass a clump member stands for in its contacts (m* of the contact law).
     #[serde(default)]
     pub clump_contact_mass: ClumpContactMass,
+    /// Integrate the spins of single spheres (default true). Off, every sphere keeps ω = 0: contact
+    /// torques are ignored, as in the 3D probe-indentation runs of Jasion (2013, Appendix C). Clump
+    /// bodies always rotate.
+    #[serde(default = "yes")]
+    pub rotation: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The mass a clump member stands for in its contacts: the contact laws compute m* = 1/(1/mᵢ + 1/mⱼ) from
@@ -79,6 +88,7 @@ impl Default for Settings {
             max_overlap_fraction: 0.25,
             domain: None,
             clump_contact_mass: ClumpContactMass::Body,
+            rotation: true,
         }
     }
 }
@@ -565,6 +575,9 @@ impl<L: ContactLaw> Simulation<L> {
                 }
                 let vmax = self.kick_drift(0.5, true, true);
                 let vmax = vmax.max(self.bodies_kick(0.5, true, true));
+                if !self.settings.rotation {
+                    self.clear_spins();
+                }
                 self.advance_time(vmax);
                 self.half_step_velocities = true;
                 self.maybe_rebuild();
@@ -588,6 +601,9 @@ impl<L: ContactLaw> Simulation<L> {
         }
         self.st.step += 1;
         self.st.energy_requested = false;
+        if !self.settings.rotation {
+            self.clear_spins();
+        }
         self.check_finite()
     }
 
@@ -732,6 +748,8 @@ impl<L: ContactLaw> Simulation<L> {
 
 #[cfg(test)]
 mod clump_tests;
+#[cfg(test)]
+mod contact_option_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

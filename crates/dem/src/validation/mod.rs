@@ -1,13 +1,14 @@
 //! Verification cases of `spatter validate`: Chung & Ooi (2011) tests 1–8 (tests 2, 3, 4 and 6 also
 //! against an STL plane with the impact on a face, a shared edge and a shared vertex), energy
 //! conservation of an elastic gas, a settled pile, rigid multi-sphere bodies (template inertia,
-//! torque-free rotation, one-sphere clump, dumbbell impacts) and erosion wear (Finnie's f(γ), single
-//! impacts).
+//! torque-free rotation, one-sphere clump, dumbbell impacts), erosion wear (Finnie's f(γ), single
+//! impacts) and the integrator study (Jasion 2013, Appendices A and B).
 
 pub mod bulk;
 pub mod chung_ooi;
 pub mod clumps;
 pub mod impact;
+pub mod integrator_study;
 pub mod wear;
 
 use spatter_core::validation::Case;
@@ -33,6 +34,9 @@ pub fn validation_cases() -> Vec<Case> {
         Case { name: "clump_dumbbell_on_end", run: clumps::dumbbell_on_end },
         Case { name: "wear_finnie_angle_function", run: wear::finnie_table },
         Case { name: "wear_single_impact", run: wear::single_oblique_impact },
+        Case { name: "integrator_normal_impact", run: integrator_study::normal_impact },
+        Case { name: "integrator_smooth_orders", run: integrator_study::smooth_orders },
+        Case { name: "integrator_discontinuity_orders", run: integrator_study::discontinuity_orders },
     ]
 }
 

@@ -122,6 +122,14 @@ pub struct ContactConfig {
     /// `elastic` ([`spatter_dem::contact::CoulombLoad`]).
     #[serde(default)]
     pub coulomb_load: spatter_dem::contact::CoulombLoad,
+    /// Hooke with linear cohesion: cohesion radius over particle radius, r_coh/r ≥ 1 (default 1.1, the
+    /// value of Jasion 2013, Table C.2). Acts only in pairs with `cohesion_stiffness_n_m` > 0.
+    #[serde(default = "default_cohesion_ratio")]
+    pub cohesion_radius_ratio: f64,
+}
+
+fn default_cohesion_ratio() -> f64 {
+    1.1
 }
 
 fn default_linear_ratio() -> f64 {
@@ -144,6 +152,7 @@ impl Default for ContactConfig {
             jkr_damping: Default::default(),
             adhesive_coulomb: Default::default(),
             coulomb_load: Default::default(),
+            cohesion_radius_ratio: default_cohesion_ratio(),
         }
     }
 }
@@ -222,6 +231,9 @@ pub struct EngineConfig {
     /// The mass a clump member stands for in its contacts: `body` (default) or `member_share`.
     #[serde(default)]
     pub clump_contact_mass: spatter_dem::sim::ClumpContactMass,
+    /// Integrate the spins of the spheres (default true); false keeps every sphere at ω = 0.
+    #[serde(default = "yes")]
+    pub rotation: bool,
 }
 
 fn residual() -> spatter_dem::sim::EnergyMethod {
@@ -245,6 +257,7 @@ impl Default for EngineConfig {
             track_energy: true,
             energy_method: residual(),
             clump_contact_mass: Default::default(),
+            rotation: true,
         }
     }
 }
@@ -278,6 +291,13 @@ pub struct PairValues {
     /// `full` (default) or `power_law` form of Thornton's e(V).
     #[serde(default)]
     pub thornton_form: spatter_dem::restitution_models::ThorntonForm,
+    /// `normal = "hooke"`: the pair's own linear stiffness k_n \[N/m\] (default: the global
+    /// `contact.hooke_*` choice). A particle–wall pair sets the wall stiffness this way.
+    #[serde(default)]
+    pub stiffness_n_m: Option<f64>,
+    /// `normal = "hooke"`: linear cohesion stiffness k_coh ≥ 0 \[N/m\] (default 0 = none).
+    #[serde(default)]
+    pub cohesion_stiffness_n_m: f64,
 }
 
 /// How a pair's coefficient of restitution is given.
@@ -306,6 +326,8 @@ impl Default for PairValues {
             restitution_model: RestitutionKind::Constant,
             yield_stress_pa: None,
             thornton_form: Default::default(),
+            stiffness_n_m: None,
+            cohesion_stiffness_n_m: 0.0,
         }
     }
 }
@@ -332,6 +354,10 @@ pub struct PairOverride {
     pub yield_stress_pa: Option<f64>,
     #[serde(default)]
     pub thornton_form: Option<spatter_dem::restitution_models::ThorntonForm>,
+    #[serde(default)]
+    pub stiffness_n_m: Option<f64>,
+    #[serde(default)]
+    pub cohesion_stiffness_n_m: Option<f64>,
 }
 
 /// A wall.
@@ -619,6 +645,42 @@ fn check_material_name(c: &mut Checker, cfg: &SceneConfig, key: &str, name: &str
     }
 }
 
+/// Per-pair stiffness and cohesion need the Hooke normal law, and cohesion a constant restitution.
+fn check_linear_pair_keys(
+    c: &mut Checker,
+    normal: NormalKind,
+    stiffness: Option<f64>,
+    cohesion: Option<f64>,
+    thornton: bool,
+) {
+    if let Some(k) = stiffness {
+        c.positive("stiffness_n_m", k);
+        if normal != NormalKind::Hooke {
+            c.fail(
+                "stiffness_n_m",
+                format!("stiffness_n_m = {k} applies to contact.normal = \"hooke\" only"),
+            );
+        }
+    }
+    if let Some(k) = cohesion {
+        c.non_negative("cohesion_stiffness_n_m", k);
+        if k > 0.0 && normal != NormalKind::Hooke {
+            c.fail(
+                "cohesion_stiffness_n_m",
+                format!("cohesion_stiffness_n_m = {k} applies to contact.normal = \"hooke\" only"),
+            );
+        }
+        if k > 0.0 && thornton {
+            c.fail(
+                "cohesion_stiffness_n_m",
+                "linear cohesion is combined with a constant restitution only (restitution_model = \
+                 \"constant\")"
+                    .to_string(),
+            );
+        }
+    }
+}
+
 fn check_pair_values(c: &mut Checker, v: &PairValues) {
     c.non_negative("friction", v.friction);
     c.in_range("restitution", v.restitution, 0.0, false, 1.0, true);
@@ -652,6 +714,14 @@ pub const MAX_STEPS: f64 = 1e11;
 /// Memory per particle of a scene, for the size estimate before a fill \[B\] (state, neighbour list and
 /// contact history of a settled packing, with margin).
 pub const BYTES_PER_PARTICLE: u64 = 1000;
+
+impl SceneConfig {
+    /// Some pair has linear cohesion (`cohesion_stiffness_n_m` > 0).
+    pub fn has_cohesion(&self) -> bool {
+        self.pair_defaults.cohesion_stiffness_n_m > 0.0
+            || self.pairs.iter().any(|p| p.cohesion_stiffness_n_m.is_some_and(|k| k > 0.0))
+    }
+}
 
 impl Validate for SceneConfig {
     fn validate(&self, c: &mut Checker) {
@@ -704,14 +774,17 @@ impl Validate for SceneConfig {
                 match (k.hooke_stiffness_n_m, k.hooke_characteristic_speed_m_s) {
                     (Some(s), None) => c.positive("hooke_stiffness_n_m", s),
                     (None, Some(v)) => c.positive("hooke_characteristic_speed_m_s", v),
+                    // Every pair has its own stiffness.
+                    (None, None) if self.pair_defaults.stiffness_n_m.is_some() => {}
                     _ => c.fail(
                         "hooke_stiffness_n_m",
                         "normal = \"hooke\" needs exactly one of hooke_stiffness_n_m or \
-                         hooke_characteristic_speed_m_s"
+                         hooke_characteristic_speed_m_s (or pair_defaults.stiffness_n_m)"
                             .to_string(),
                     ),
                 }
             }
+            c.in_range("cohesion_radius_ratio", k.cohesion_radius_ratio, 1.0, true, 2.0, true);
             c.positive("linear_stiffness_ratio", k.linear_stiffness_ratio);
             if matches!(k.normal, NormalKind::Jkr | NormalKind::Dmt | NormalKind::Sjkr)
                 && k.tangential != TangentialKind::Mindlin
@@ -755,8 +828,28 @@ impl Validate for SceneConfig {
             if let Some(v) = e.impact_speed_m_s {
                 c.positive("impact_speed_m_s", v);
             }
+            if !e.rotation && !self.templates.is_empty() {
+                c.fail(
+                    "rotation",
+                    "rotation = false applies to spheres; this scene has clump templates, whose bodies \
+                     always rotate — remove [templates] or set rotation = true"
+                        .to_string(),
+                );
+            }
         });
-        c.nested("pair_defaults", |c| check_pair_values(c, &self.pair_defaults));
+        let thornton = self.pair_defaults.restitution_model == RestitutionKind::Thornton
+            || self.pairs.iter().any(|p| p.restitution_model == Some(RestitutionKind::Thornton));
+        c.nested("pair_defaults", |c| {
+            check_pair_values(c, &self.pair_defaults);
+            let d = &self.pair_defaults;
+            check_linear_pair_keys(
+                c,
+                self.contact.normal,
+                d.stiffness_n_m,
+                Some(d.cohesion_stiffness_n_m),
+                thornton,
+            );
+        });
         for (i, p) in self.pairs.iter().enumerate() {
             c.element("pairs", i, |c| {
                 for (k, m) in p.materials.iter().enumerate() {
@@ -767,6 +860,13 @@ impl Validate for SceneConfig {
                 c.non_negative("rolling_friction", p.rolling_friction.unwrap_or(0.0));
                 c.non_negative("rolling_viscous_s_m", p.rolling_viscous_s_m.unwrap_or(0.0));
                 c.non_negative("work_of_adhesion_j_m2", p.work_of_adhesion_j_m2.unwrap_or(0.0));
+                check_linear_pair_keys(
+                    c,
+                    self.contact.normal,
+                    p.stiffness_n_m,
+                    p.cohesion_stiffness_n_m,
+                    thornton,
+                );
                 let d = &self.pair_defaults;
                 check_restitution_model(
                     c,

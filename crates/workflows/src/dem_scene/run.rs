@@ -10,8 +10,8 @@ use spatter_core::{Aabb, Vec3};
 use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
 use spatter_dem::clump::NewBody;
 use spatter_dem::contact::{
-    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearHistory, Mindlin, MindlinVariant,
-    RestitutionDamping,
+    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearCohesion, LinearHistory, Mindlin,
+    MindlinVariant, RestitutionDamping,
 };
 use spatter_dem::error::DemError;
 use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
@@ -161,7 +161,16 @@ pub fn run_collect(
         };
     }
     // One monomorphised engine per combination.
+    let cohesive = LinearCohesion { hooke, radius_ratio: c.cohesion_radius_ratio };
     match (c.normal, c.tangential) {
+        // Linear cohesion (Hooke with an attractive cohesion spring) only where some pair has it.
+        (NormalKind::Hooke, TangentialKind::Linear) if cfg.has_cohesion() => {
+            run_with(configured(Composed::new(cohesive, damping, linear, r), cfg), built, cfg, ctx)
+        }
+        (NormalKind::Hooke, k) if cfg.has_cohesion() => {
+            let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
+            run_with(configured(Composed::new(cohesive, damping, t, r), cfg), built, cfg, ctx)
+        }
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
             run_with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
         }
@@ -323,6 +332,7 @@ fn run_with<L: ContactLaw>(
             _ => None,
         },
         clump_contact_mass: e.clump_contact_mass,
+        rotation: e.rotation,
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method =

@@ -102,6 +102,12 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
             if let Some(f) = p.thornton_form {
                 v.thornton_form = f;
             }
+            if let Some(k) = p.stiffness_n_m {
+                v.stiffness_n_m = Some(k);
+            }
+            if let Some(k) = p.cohesion_stiffness_n_m {
+                v.cohesion_stiffness_n_m = k;
+            }
         }
     }
     let pairs = PairTable::build(n, |a, b| {
@@ -110,6 +116,8 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         p.rolling_friction = v.rolling_friction;
         p.rolling_viscous = v.rolling_viscous_s_m;
         p.work_of_adhesion = v.work_of_adhesion_j_m2;
+        p.stiffness = v.stiffness_n_m;
+        p.cohesion_stiffness = v.cohesion_stiffness_n_m;
         p.restitution_model = Some(match v.restitution_model {
             RestitutionKind::Constant => RestitutionModel::Constant { restitution: v.restitution },
             RestitutionKind::Thornton => RestitutionModel::Thornton {

@@ -350,6 +350,7 @@ pub fn run_impact<L: ContactLaw>(
                 normal: g.n,
                 overlap: g.overlap,
                 r_eff,
+                radius_sum: if g.r_partner.is_finite() { r + g.r_partner } else { r },
                 m_eff,
                 i_eff,
                 v_rel,
