@@ -305,6 +305,8 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         restitution_model: None,
         yield_stress_pa: None,
         thornton_form: None,
+        stiffness_n_m: None,
+        cohesion_stiffness_n_m: None,
     };
     let mesh = |name: &str, material: &str| WallConfig {
         name: name.to_string(),
