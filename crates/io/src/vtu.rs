@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
 
-use crate::vtk::cell_type::{HEXAHEDRON as VTK_HEXAHEDRON, TRIANGLE as VTK_TRIANGLE, VERTEX as VTK_VERTEX};
+use crate::vtk::cell_type::{TRIANGLE as VTK_TRIANGLE, VERTEX as VTK_VERTEX};
 
 /// Builder for one `.vtu` file.
 #[derive(Clone, Debug)]
@@ -66,30 +66,14 @@ impl Vtu {
                 }
             }
         }
-        let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as i64;
-        let n = nx * ny * nz;
-        let mut connectivity = Vec::with_capacity(8 * n);
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    connectivity.extend_from_slice(&[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ]);
-                }
-            }
-        }
+        // The same hexahedra the VTK reader builds for a structured block of (n + 1)³ points.
+        let (types, offsets, connectivity) =
+            crate::vtk::VtkDataset::structured_cells([nx + 1, ny + 1, nz + 1]);
         Vtu {
             points,
-            connectivity,
-            offsets: (1..=n as i64).map(|c| 8 * c).collect(),
-            types: vec![VTK_HEXAHEDRON; n],
+            connectivity: connectivity.into_iter().map(i64::from).collect(),
+            offsets: offsets[1..].iter().map(|&o| o as i64).collect(),
+            types,
             point_data: Vec::new(),
             cell_data: Vec::new(),
         }
