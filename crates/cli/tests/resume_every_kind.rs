@@ -439,7 +439,7 @@ output_interval_s = 0.002
 #[test]
 fn integrator_study_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    let text = include_str!("../../../examples/dem_integrators.toml")
+    let text = include_str!("../../../examples/integrator_orders.toml")
         .replace("max_steps = 10000", "max_steps = 300");
     let s = write(dir.path(), "integrators.toml", text.as_bytes());
     stop_and_resume(&s, 4, "integrator_study");
