@@ -79,6 +79,12 @@ fn a_run_writes_every_output() {
     assert!(!tmp.path().join("log.txt").exists(), "the scene writes no log.txt itself");
     let cost = summary.headline.iter().find(|l| l.contains("run cost:")).expect("a run-cost line");
     assert!(cost.contains("core-hours"), "{cost}");
+    // The wetting picture is recorded for a study's gallery: its squares and values, each in [0, 1].
+    let map = summary.maps.iter().find(|m| m.label == "tank wetting").expect("wetting map recorded");
+    let squares = spatter_io::vtk::read(&map.vtu).unwrap();
+    let fraction = &squares.cell_array(&map.array).unwrap().values;
+    assert_eq!(fraction.len() * 3, squares.connectivity.len());
+    assert!(fraction.iter().all(|f| (0.0..=1.0).contains(f)) && fraction.iter().any(|&f| f > 0.0));
     assert!(!tmp.path().join("checkpoint.bin").exists(), "a finished run leaves no checkpoint");
 }
 
