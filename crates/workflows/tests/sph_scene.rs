@@ -509,7 +509,7 @@ fn adhesion_outside_the_calibrated_range_is_warned_about() {
     };
     for (st, f, warned) in [(0.072, 10.0, true), (0.072, 1.0, false), (0.0, 10.0, false)] {
         let cfg = config(&with(st, f));
-        let (_, info) = build(&cfg, Path::new(".")).unwrap();
+        let (_, info) = build(&cfg).unwrap();
         let line = "wall `tank`: adhesion 10 is above the calibrated range 0.75–3";
         assert_eq!(
             info.warnings.iter().any(|w| w.starts_with(line)),

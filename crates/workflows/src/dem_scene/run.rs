@@ -102,7 +102,7 @@ pub fn run_collect(
     cfg: &SceneConfig,
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
-    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
+    Checker::run(cfg, None).map_err(DemError::Invalid)?;
     let c = &cfg.contact;
     let damping = RestitutionDamping {
         tensile_clamp: c.tensile_clamp,
@@ -681,7 +681,7 @@ fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> 
             b = b.grown_to(*x);
         }
         for j in &cfg.inject {
-            if let Ok(r) = setup::region(cfg, &j.region) {
+            if let Ok(r) = setup::region(&j.region) {
                 b = b.union(r.bounds());
             }
         }

@@ -146,14 +146,9 @@ fn io_at(path: &Path) -> impl Fn(std::io::Error) -> SphError + '_ {
     move |e| SphError::Io(std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }
 
-/// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). Relative paths in the
-/// configuration are resolved against the current directory.
+/// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). File paths are taken as given
+/// (the scenario loader has made them absolute; see [`spatter_io::paths`]).
 pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
-    run_in(cfg, ctx, Path::new("."))
-}
-
-/// Like [`run`], resolving relative paths against `base`.
-pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSummary, SphError> {
     let dir = ctx.dir;
     let root = dir.root().to_owned();
     let ckpt = dir.checkpoint_path();
@@ -171,7 +166,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
         tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
         (st, series, pvd)
     } else {
-        let (sim, info) = build(cfg, base)?;
+        let (sim, info) = build(cfg)?;
         tracing::info!(
             "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s)",
             cfg.title,

@@ -340,7 +340,7 @@ pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingErr
         plan.t_end,
         plan.x_front0 + plan.speed.distance(plan.t_end)
     );
-    let mut summary = crate::sph_scene::run_in(&scfg, ctx, &geo)?;
+    let mut summary = crate::sph_scene::run(&scfg, ctx)?;
     if summary.finished != Finished::Completed {
         return Ok(summary);
     }
