@@ -103,6 +103,34 @@ pub fn run_collect(
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
     Checker::run(cfg, None).map_err(DemError::Invalid)?;
+    with_law(cfg, SceneRun { cfg, ctx })
+}
+
+/// The scene's own run, as a [`WithLaw`] visitor.
+struct SceneRun<'a> {
+    cfg: &'a SceneConfig,
+    ctx: &'a RunContext<'a>,
+}
+
+impl WithLaw for SceneRun<'_> {
+    type Output = (RunSummary, Option<SceneResults>);
+    fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError> {
+        run_with(law, built, self.cfg, self.ctx)
+    }
+}
+
+/// Something run with the contact law a scene chooses (`[contact]` and the pairs decide the law's type,
+/// so the engine is monomorphised for it): the scene's own run, or a workflow that drives the DEM itself
+/// (the `cfd_dem` kind).
+pub trait WithLaw {
+    type Output;
+    /// Called once with the scene's law and its built materials, pairs, walls and templates.
+    fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError>;
+}
+
+/// Builds the scene's engine objects and calls `v` with the contact law `[contact]` chooses (one
+/// monomorphised engine per combination). The scene must have been validated.
+pub fn with_law<V: WithLaw>(cfg: &SceneConfig, v: V) -> Result<V::Output, DemError> {
     let c = &cfg.contact;
     let damping = RestitutionDamping {
         tensile_clamp: c.tensile_clamp,
@@ -132,32 +160,20 @@ pub fn run_collect(
         let ac = c.adhesive_coulomb;
         return match (c.normal, c.tangential) {
             (NormalKind::Hertz, TangentialKind::Linear) => {
-                run_with(configured(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
+                v.with(configured(Composed::new(Hertz, d, linear, r), cfg), built)
             }
-            (NormalKind::Hertz, _) => {
-                run_with(configured(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
-            }
+            (NormalKind::Hertz, _) => v.with(configured(Composed::new(Hertz, d, variant, r), cfg), built),
             (NormalKind::Hooke, TangentialKind::Linear) => {
-                run_with(configured(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
+                v.with(configured(Composed::new(hooke, d, linear, r), cfg), built)
             }
-            (NormalKind::Hooke, _) => {
-                run_with(configured(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
+            (NormalKind::Hooke, _) => v.with(configured(Composed::new(hooke, d, variant, r), cfg), built),
+            (NormalKind::Jkr, _) => v.with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built),
+            (NormalKind::Dmt, _) => {
+                v.with(configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg), built)
             }
-            (NormalKind::Jkr, _) => {
-                run_with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
+            (NormalKind::Sjkr, _) => {
+                v.with(configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg), built)
             }
-            (NormalKind::Dmt, _) => run_with(
-                configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg),
-                built,
-                cfg,
-                ctx,
-            ),
-            (NormalKind::Sjkr, _) => run_with(
-                configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg),
-                built,
-                cfg,
-                ctx,
-            ),
         };
     }
     // One monomorphised engine per combination.
@@ -165,47 +181,41 @@ pub fn run_collect(
     match (c.normal, c.tangential) {
         // Linear cohesion (Hooke with an attractive cohesion spring) only where some pair has it.
         (NormalKind::Hooke, TangentialKind::Linear) if cfg.has_cohesion() => {
-            run_with(configured(Composed::new(cohesive, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(cohesive, damping, linear, r), cfg), built)
         }
         (NormalKind::Hooke, k) if cfg.has_cohesion() => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(cohesive, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(cohesive, damping, t, r), cfg), built)
         }
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
-            run_with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built)
         }
         (NormalKind::Hertz, TangentialKind::Linear) => {
-            run_with(configured(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, linear, r), cfg), built)
         }
         (NormalKind::Hooke, TangentialKind::Mindlin) => {
-            run_with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built)
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
-            run_with(configured(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, linear, r), cfg), built)
         }
         // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
         (NormalKind::Hertz, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, t, r), cfg), built)
         }
         (NormalKind::Hooke, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, t, r), cfg), built)
         }
-        (NormalKind::Jkr, _) => {
-            run_with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
-        }
-        (NormalKind::Dmt, _) => run_with(
+        (NormalKind::Jkr, _) => v.with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built),
+        (NormalKind::Dmt, _) => v.with(
             configured(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
-            cfg,
-            ctx,
         ),
-        (NormalKind::Sjkr, _) => run_with(
+        (NormalKind::Sjkr, _) => v.with(
             configured(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
-            cfg,
-            ctx,
         ),
     }
 }
@@ -315,12 +325,9 @@ fn configured<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> C
     law
 }
 
-fn run_with<L: ContactLaw>(
-    law: L,
-    built: setup::Built,
-    cfg: &SceneConfig,
-    ctx: &RunContext,
-) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+/// The scene's simulation with its law, engine settings, gravity, walls, templates and wear models, and
+/// no particles yet (the fills are [`setup::initial_particles`]).
+pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig) -> Simulation<L> {
     let e = &cfg.engine;
     let settings = spatter_dem::sim::Settings {
         integrator: e.integrator,
@@ -345,6 +352,16 @@ fn run_with<L: ContactLaw>(
         sim.add_template(t);
     }
     sim.set_wear(built.wear);
+    sim
+}
+
+fn run_with<L: ContactLaw>(
+    law: L,
+    built: setup::Built,
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    let mut sim = simulation(law, built, cfg);
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
     let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
@@ -604,7 +621,7 @@ fn write_wear_maps<L: ContactLaw>(
 
 /// Places the particles injector `k` owes at the current time, clear of the particles present and of the
 /// walls where they are now.
-fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
+pub(crate) fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
     let t = sim.time();
     if t < inj.start || (inj.due(t) == 0 && inj.state.pending.is_some()) {
         return;
@@ -653,7 +670,7 @@ fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &R
 }
 
 /// Time-step warnings for the particles present and to be injected.
-fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<String> {
+pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<String> {
     let mut sizes: Vec<(usize, f64)> = Vec::new();
     let p = &sim.particles;
     for i in 0..p.len() {
