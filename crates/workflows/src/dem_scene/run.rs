@@ -333,6 +333,7 @@ fn run_with<L: ContactLaw>(
         },
         clump_contact_mass: e.clump_contact_mass,
         rotation: e.rotation,
+        iterations: e.iterations,
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method =
