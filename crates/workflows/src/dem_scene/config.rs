@@ -193,9 +193,13 @@ impl TangentialKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EngineConfig {
-    /// `velocity_verlet` (default) or `symplectic_euler`.
+    /// `velocity_verlet` (default), `symplectic_euler` (or `se`), or one of the study schemes `fe`,
+    /// `rk2`, `rk4`, `ab2`, `ab4`, `abm4`, `bd1`, `bd2`, `bd4` (spheres only).
     #[serde(default)]
     pub integrator: Integrator,
+    /// Fixed-point iterations per step of the implicit `bd1`, `bd2`, `bd4` (required by them, ≥ 1).
+    #[serde(default)]
+    pub iterations: Option<u32>,
     /// Verlet skin \[m\] (default 10 % of the largest diameter).
     #[serde(default)]
     pub skin_m: Option<f64>,
@@ -244,6 +248,7 @@ impl Default for EngineConfig {
     fn default() -> Self {
         EngineConfig {
             integrator: Integrator::VelocityVerlet,
+            iterations: None,
             skin_m: None,
             verlet_list: true,
             max_overlap_fraction: default_overlap_fraction(),
@@ -815,6 +820,35 @@ impl Validate for SceneConfig {
             }
             if let Some(v) = e.impact_speed_m_s {
                 c.positive("impact_speed_m_s", v);
+            }
+            if let Some(scheme) = e.integrator.scheme() {
+                if scheme.is_implicit() && e.iterations.unwrap_or(0) == 0 {
+                    c.fail(
+                        "iterations",
+                        format!(
+                            "integrator = \"{}\" is implicit and needs iterations ≥ 1 (fixed-point iterations \
+                             per step; BD-p keeps its order with ≥ p, e.g. iterations = {})",
+                            e.integrator.label().to_lowercase(),
+                            scheme.nominal_order() + 1
+                        ),
+                    );
+                }
+                if scheme != spatter_dem::integrators::Scheme::Se && !self.templates.is_empty() {
+                    c.fail(
+                        "integrator",
+                        format!(
+                            "integrator = \"{}\" runs single spheres only; this scene has clump templates — \
+                             use \"velocity_verlet\" or \"symplectic_euler\"",
+                            e.integrator.label().to_lowercase()
+                        ),
+                    );
+                }
+            }
+            if e.iterations.is_some() && !e.integrator.scheme().is_some_and(|s| s.is_implicit()) {
+                c.fail(
+                    "iterations",
+                    "iterations applies to the implicit integrators bd1, bd2, bd4 only; remove it".to_string(),
+                );
             }
             if !e.rotation && !self.templates.is_empty() {
                 c.fail(

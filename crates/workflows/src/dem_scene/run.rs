@@ -340,6 +340,7 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
         },
         clump_contact_mass: e.clump_contact_mass,
         rotation: e.rotation,
+        iterations: e.iterations,
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method =
