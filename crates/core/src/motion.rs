@@ -57,6 +57,13 @@ pub enum Motion {
         angular_speed: f64,
     },
     Tabulated(MotionTable),
+    /// Node `node` of a kinematic tree: its own motion relative to its parent's reference frame, composed
+    /// with every ancestor's (a wheel spinning on a moving chassis), for an engine that moves each wall by
+    /// one motion.
+    Nested {
+        tree: Box<KinematicTree>,
+        node: usize,
+    },
 }
 
 /// A velocity history `t vx vy vz wx wy wz` (SI units; ω in rad/s about the moving reference point),
@@ -236,6 +243,13 @@ impl Motion {
                 rotation: Quat::from_axis_angle(*axis, angular_speed * t),
             },
             Motion::Tabulated(table) => table.pose(t),
+            Motion::Nested { tree, node } => {
+                // The node's own reference point, carried through the whole chain; a rigid placement is
+                // fixed by where that point goes and by the rotation.
+                let pivot = tree.nodes[*node].0.pose(0.0).pivot;
+                let translation = tree.world_point(*node, t, pivot) - pivot;
+                Pose { pivot, translation, rotation: tree.rotation(*node, t) }
+            }
         }
     }
 
@@ -250,6 +264,7 @@ impl Motion {
                 let c = table.pose(t).center();
                 v + w.cross(x - c)
             }
+            Motion::Nested { tree, node } => tree.velocity_at(*node, t, x),
         }
     }
 
@@ -259,6 +274,7 @@ impl Motion {
             Motion::Fixed | Motion::Translation { .. } => Vec3::ZERO,
             Motion::Rotation { axis, angular_speed, .. } => *axis * *angular_speed,
             Motion::Tabulated(table) => table.rates(t).1,
+            Motion::Nested { tree, node } => tree.angular_velocity(*node, t),
         }
     }
 }
@@ -290,6 +306,15 @@ impl KinematicTree {
 
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// The motion of node `i` in the world: its own motion when it has no parent, else the composed
+    /// [`Motion::Nested`].
+    pub fn world_motion(&self, i: usize) -> Motion {
+        match &self.nodes[i] {
+            (own, None) => own.clone(),
+            (_, Some(_)) => Motion::Nested { tree: Box::new(self.clone()), node: i },
+        }
     }
 
     /// World placement of body `i` at time `t`, as a map from its reference coordinates to the world.
@@ -404,5 +429,36 @@ mod tests {
         assert!(tree.velocity_at(wheel, t, bottom).length() < 1e-12);
         assert!((tree.velocity_at(wheel, t, top) - Vec3::new(20.0, 0.0, 0.0)).length() < 1e-12);
         assert!((tree.angular_velocity(wheel, t) - Vec3::new(0.0, 20.0, 0.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_nested_motion_moves_as_its_tree_node() {
+        // A wheel (ω = 20 rad/s about y through (0, 0, 0.5)) on a chassis that turns at 0.4 rad/s about z
+        // through (2, 1, 0) while a table drives it along x: the single motion of the wheel places every
+        // point, and gives its velocity and spin, as the tree does (round-off only).
+        let table =
+            MotionTable::parse("0 1 0 0 0 0 0.4\n10 3 0 0 0 0 0.4\n", Vec3::new(2.0, 1.0, 0.0)).unwrap();
+        let mut tree = KinematicTree::new();
+        let chassis = tree.add(Motion::Tabulated(table), None);
+        let wheel = tree.add(Motion::rotation(Vec3::new(0.0, 0.0, 0.5), Vec3::Y, 20.0), Some(chassis));
+        let nested = tree.world_motion(wheel);
+        assert!(matches!(nested, Motion::Nested { .. }));
+        assert_eq!(tree.world_motion(chassis), tree.nodes[chassis].0, "a root node is its own motion");
+        for t in [0.0, 0.37, 2.5] {
+            let pose = nested.pose(t);
+            for x0 in [Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.3, -0.2, 0.9), Vec3::new(-1.0, 2.0, 0.0)] {
+                let want = tree.world_point(wheel, t, x0);
+                assert!((pose.apply(x0) - want).length() < 1e-12, "t = {t}: {x0}");
+                let x = want;
+                assert!((nested.velocity_at(t, x) - tree.velocity_at(wheel, t, x)).length() < 1e-12);
+                assert!((pose.inverse_apply(x) - x0).length() < 1e-12);
+            }
+            assert!((nested.angular_velocity(t) - tree.angular_velocity(wheel, t)).length() < 1e-12);
+        }
+        // Analytic: after 2.5 s the chassis has turned 1 rad about z, so the wheel spins about the turned y
+        // axis, plus the chassis's own 0.4 rad/s about z.
+        let w = nested.angular_velocity(2.5);
+        let want = Vec3::new(-20.0 * 1f64.sin(), 20.0 * 1f64.cos(), 0.4);
+        assert!((w - want).length() < 1e-12, "{w} vs {want}");
     }
 }

@@ -9,6 +9,7 @@ pub mod dem_scene;
 pub mod deposition;
 pub mod fluid_forces;
 pub mod gravelometer;
+pub mod motions;
 pub mod snow;
 pub mod sph_scene;
 pub mod wading;

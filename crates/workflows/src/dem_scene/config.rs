@@ -46,6 +46,9 @@ pub struct SceneConfig {
     pub pairs: Vec<PairOverride>,
     #[serde(default)]
     pub walls: Vec<WallConfig>,
+    /// Prescribed motions, a tree (see [`crate::motions`]); walls name the node they follow.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub motions: Vec<MotionConfig>,
     /// Particles placed at t = 0.
     #[serde(default)]
     pub fill: Vec<FillConfig>,
@@ -368,8 +371,9 @@ pub struct WallConfig {
     pub name: String,
     pub material: String,
     pub shape: ShapeConfig,
-    #[serde(default)]
-    pub motion: MotionConfig,
+    /// Name of the `[[motions]]` node the wall follows (default: fixed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<String>,
 }
 
 /// Wall geometry (`type = "plane" | "rectangle" | "cylinder" | "mesh"`).
@@ -405,27 +409,7 @@ fn one() -> f64 {
     1.0
 }
 
-/// Prescribed wall motion (`type = "fixed" | "translation" | "rotation" | "tabulated"`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub enum MotionConfig {
-    #[default]
-    Fixed,
-    Translation {
-        velocity_m_s: Vec3,
-    },
-    Rotation {
-        center_m: Vec3,
-        axis: Vec3,
-        angular_speed_rad_s: f64,
-    },
-    /// A file of rows `t vx vy vz wx wy wz` (SI), linearly interpolated; ω about `reference_point_m`.
-    Tabulated {
-        file: PathBuf,
-        #[serde(default)]
-        reference_point_m: Vec3,
-    },
-}
+pub use crate::motions::{MotionConfig, MotionType};
 
 /// A region for fills and injections (`type = "box" | "cylinder" | "mesh"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -898,6 +882,7 @@ impl Validate for SceneConfig {
                 );
             });
         }
+        crate::motions::check_tree(c, &self.motions);
         for (i, w) in self.walls.iter().enumerate() {
             c.element("walls", i, |c| {
                 check_material_name(c, self, "material", &w.material);
@@ -938,19 +923,7 @@ impl Validate for SceneConfig {
                         c.positive("scale", *scale);
                     }
                 });
-                c.nested("motion", |c| match &w.motion {
-                    MotionConfig::Fixed => {}
-                    MotionConfig::Translation { velocity_m_s } => c.finite_vec("velocity_m_s", *velocity_m_s),
-                    MotionConfig::Rotation { center_m, axis, angular_speed_rad_s } => {
-                        c.finite_vec("center_m", *center_m);
-                        check_direction(c, "axis", *axis);
-                        c.finite("angular_speed_rad_s", *angular_speed_rad_s);
-                    }
-                    MotionConfig::Tabulated { file, reference_point_m } => {
-                        c.motion_table_file("file", file);
-                        c.finite_vec("reference_point_m", *reference_point_m);
-                    }
-                });
+                crate::motions::check_reference(c, "motion", w.motion.as_deref(), &self.motions);
             });
         }
         c.nested("output", |c| {

@@ -5,7 +5,7 @@ use super::config::*;
 use spatter_core::distribution::SizeDistribution;
 use spatter_core::material::Material;
 use spatter_core::mesh::TriMesh;
-use spatter_core::motion::{Motion, MotionTable};
+use spatter_core::motion::Motion;
 use spatter_core::rng::{seeded, Rng};
 use spatter_core::{Aabb, Vec3};
 use spatter_dem::clump::{ClumpTemplate, NewBody};
@@ -126,6 +126,8 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         });
         p
     });
+    let tree = crate::motions::tree(&cfg.motions)
+        .map_err(|(i, message)| DemError::Config { key: format!("motions[{i}]"), message })?;
     let mut walls = Vec::new();
     for (i, w) in cfg.walls.iter().enumerate() {
         let material = material_index(cfg, &w.material, &format!("walls[{i}].material"))?;
@@ -148,21 +150,9 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
                 WallShape::Mesh(Box::new(MeshWall::new(TriMesh::load(file, *scale)?)))
             }
         };
-        let motion = match &w.motion {
-            MotionConfig::Fixed => Motion::Fixed,
-            MotionConfig::Translation { velocity_m_s } => Motion::Translation { velocity: *velocity_m_s },
-            MotionConfig::Rotation { center_m, axis, angular_speed_rad_s } => {
-                Motion::rotation(*center_m, *axis, *angular_speed_rad_s)
-            }
-            MotionConfig::Tabulated { file, reference_point_m } => {
-                let text = std::fs::read_to_string(file)
-                    .map_err(|source| DemError::Io { path: file.clone(), source })?;
-                let table = MotionTable::parse(&text, *reference_point_m).map_err(|e| DemError::Config {
-                    key: format!("walls[{i}].motion.file"),
-                    message: format!("{}: {e}", file.display()),
-                })?;
-                Motion::Tabulated(table)
-            }
+        let motion = match w.motion.as_deref().and_then(|m| cfg.motions.iter().position(|n| n.name == m)) {
+            Some(node) => tree.world_motion(node),
+            None => Motion::Fixed,
         };
         walls.push(Wall { name: w.name.clone(), shape, material, motion });
     }

@@ -5,6 +5,7 @@ use super::*;
 use spatter_core::check::Checker;
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
 use spatter_io::run::{RunContext, RunDir};
+use spatter_core::Vec3;
 use std::path::Path;
 
 /// A small pour: a box of planes, an STL floor, a lattice fill and an injector, with rolling resistance.
@@ -326,7 +327,14 @@ shape = {{ type = "cylinder", point_m = [0, 0, 0], axis = [0, 0, 1], radius_m = 
 name = "paddle"
 material = "grain"
 shape = {{ type = "rectangle", center_m = [0.04, 0, 0.06], half_u_m = [0.02, 0, 0], half_v_m = [0, 0.01, 0] }}
-motion = {{ type = "rotation", center_m = [0, 0, 0.06], axis = [0, 0, 1], angular_speed_rad_s = 5 }}
+motion = "spin"
+
+[[motions]]
+name = "spin"
+type = "rotation"
+center_m = [0, 0, 0.06]
+axis = [0, 0, 1]
+angular_speed_rad_s = 5
 
 [[walls]]
 name = "plate"
@@ -811,4 +819,67 @@ fn the_event_log_records_first_impacts_and_plane_crossings_and_resumes() {
     assert_eq!(trows.iter().filter(|r| r[1] == 1.0).count(), 30);
     assert_eq!(scalar(&s, "objects_hit_wall"), Some(2.0));
     assert_eq!(scalar(&s, "objects_crossed_plane"), Some(1.0));
+}
+
+/// A tyre wall on a wheel node (ω = 5 rad/s about y through (0, 0, 0.4)) whose parent chassis drives at
+/// 2 m/s along x: rolling without slip (v = ωR with R = 0.4 m). Analytic: the wall point at the origin at
+/// t = 0 is at (2t − 0.4 sin 5t, 0, 0.4 − 0.4 cos 5t), the contact point is at rest, the top moves at 4 m/s.
+#[test]
+fn a_wall_on_a_child_motion_rolls_with_its_chassis() {
+    let cfg = parse(
+        r#"
+dt_s = 1e-5
+duration_s = 0.001
+output_interval_s = 0.001
+[materials.rubber]
+youngs_modulus_pa = 1e7
+poisson_ratio = 0.45
+density_kg_m3 = 1100
+[pair_defaults]
+friction = 0.5
+restitution = 0.5
+[[motions]]
+name = "chassis"
+type = "translation"
+velocity_m_s = [2, 0, 0]
+[[motions]]
+name = "wheel"
+parent = "chassis"
+type = "rotation"
+center_m = [0, 0, 0.4]
+axis = [0, 1, 0]
+angular_speed_rad_s = 5
+[[walls]]
+name = "tyre"
+material = "rubber"
+shape = { type = "cylinder", point_m = [0, 0, 0.4], axis = [0, 1, 0], radius_m = 0.4, inside = false }
+motion = "wheel"
+[[walls]]
+name = "road"
+material = "rubber"
+shape = { type = "plane", point_m = [0, 0, 0], normal = [0, 0, 1] }
+"#,
+    );
+    let built = setup::build(&cfg).unwrap_or_else(|e| panic!("{e}"));
+    let (tyre, road) = (&built.walls[0].motion, &built.walls[1].motion);
+    assert!(matches!(road, spatter_core::motion::Motion::Fixed));
+    for t in [0.0, 0.1, 0.77] {
+        let p = tyre.pose(t).apply(Vec3::ZERO);
+        let th: f64 = 5.0 * t;
+        let want = Vec3::new(2.0 * t - 0.4 * th.sin(), 0.0, 0.4 - 0.4 * th.cos());
+        assert!((p - want).length() < 1e-12, "t = {t}: {p} vs {want}");
+        let centre = Vec3::new(2.0 * t, 0.0, 0.4);
+        let bottom = centre - Vec3::new(0.0, 0.0, 0.4);
+        assert!(tyre.velocity_at(t, bottom).length() < 1e-12, "the contact point is at rest");
+        let top = tyre.velocity_at(t, centre + Vec3::new(0.0, 0.0, 0.4));
+        assert!((top - Vec3::new(4.0, 0.0, 0.0)).length() < 1e-12, "{top}");
+    }
+    // A wall naming no node of [[motions]] is refused with the key.
+    let mut bad = cfg.clone();
+    bad.walls[1].motion = Some("spin".into());
+    let e = Checker::run(&bad, None).unwrap_err();
+    assert!(
+        e.iter().any(|i| i.key == "walls[1].motion" && i.message.contains("\"spin\" is not defined")),
+        "{e:?}"
+    );
 }

@@ -312,7 +312,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         name: name.to_string(),
         material: material.to_string(),
         shape: ShapeConfig::Mesh { file: geometry.join(format!("{name}.stl")), scale: 1.0 },
-        motion: Default::default(),
+        motion: None,
     };
     let templates: BTreeMap<String, TemplateConfig> =
         plan.stones.iter().map(|s| (s.name.clone(), s.config.clone())).collect();
@@ -367,6 +367,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         },
         pairs: vec![wall_pair("steel"), wall_pair("coating")],
         walls: vec![mesh(PANEL, "coating"), mesh(CLAMP, "steel"), mesh(PIPE, "steel"), mesh(BOX, "steel")],
+        motions: Vec::new(),
         fill: Vec::new(),
         inject: vec![inject],
         templates,

@@ -1,8 +1,7 @@
 //! Turns a validated [`SphConfig`] into a ready [`Simulation`].
 
-use super::config::{axis_index, face_index, FillType, MotionType, SphConfig, WallType};
+use super::config::{axis_index, face_index, FillType, SphConfig, WallType};
 use spatter_core::mesh::TriMesh;
-use spatter_core::motion::{Motion, MotionTable};
 use spatter_core::{Aabb, Vec3};
 use spatter_sph::error::SphError;
 use spatter_sph::kernel::Dim;
@@ -63,31 +62,9 @@ pub fn build(cfg: &SphConfig) -> Result<(Simulation, BuildInfo), SphError> {
     // Kinematic tree.
     let mut nodes: Vec<(&str, usize)> = Vec::new();
     for (i, m) in cfg.motions.iter().enumerate() {
-        let parent = m.parent.as_deref().and_then(|n| nodes.iter().find(|e| e.0 == n).map(|e| e.1));
-        let motion = match m.kind {
-            MotionType::Fixed => Motion::Fixed,
-            MotionType::Translation => Motion::Translation { velocity: m.velocity_m_s.unwrap_or(Vec3::ZERO) },
-            MotionType::Rotation => Motion::rotation(
-                m.center_m.unwrap_or(Vec3::ZERO),
-                m.axis.unwrap_or(Vec3::Z),
-                m.angular_speed_rad_s.unwrap_or(0.0),
-            ),
-            MotionType::Table => {
-                let file = m
-                    .file
-                    .as_deref()
-                    .ok_or_else(|| SphError::Setup(format!("motions[{i}].file is missing")))?;
-                let path = file;
-                let text = std::fs::read_to_string(path).map_err(|e| {
-                    SphError::Setup(format!("motions[{i}].file = \"{}\": {e}", path.display()))
-                })?;
-                let table =
-                    MotionTable::parse(&text, m.reference_point_m.unwrap_or(Vec3::ZERO)).map_err(|e| {
-                        SphError::Setup(format!("motions[{i}].file = \"{}\": {e}", path.display()))
-                    })?;
-                Motion::Tabulated(table)
-            }
-        };
+        let parent = crate::motions::parent_index(&cfg.motions, i).map(|k| nodes[k].1);
+        let motion =
+            crate::motions::own_motion(m).map_err(|e| SphError::Setup(format!("motions[{i}].{e}")))?;
         let node = sim.add_motion(motion, parent);
         nodes.push((m.name.as_str(), node));
     }

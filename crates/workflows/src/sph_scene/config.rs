@@ -169,40 +169,7 @@ pub struct DomainConfig {
     pub periodic: Vec<String>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MotionType {
-    Fixed,
-    Translation,
-    Rotation,
-    Table,
-}
-
-/// One node of the kinematic tree; it moves relative to its parent.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MotionConfig {
-    pub name: String,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub parent: Option<String>,
-    #[serde(rename = "type")]
-    pub kind: MotionType,
-    /// Translation.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub velocity_m_s: Option<Vec3>,
-    /// Rotation: axis point, axis direction and speed (right-hand rule).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub center_m: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub axis: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub angular_speed_rad_s: Option<f64>,
-    /// Table: `t vx vy vz wx wy wz` rows, ω about `reference_point_m` (which moves with the body).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub file: Option<PathBuf>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub reference_point_m: Option<Vec3>,
-}
+pub use crate::motions::{MotionConfig, MotionType};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -492,69 +459,14 @@ impl Validate for SphConfig {
                 c.fail("periodic", "periodic axes need the domain box `min_m` and `max_m`");
             }
         });
-        let motion_names: Vec<&str> = self.motions.iter().map(|m| m.name.as_str()).collect();
-        for (i, m) in self.motions.iter().enumerate() {
-            c.element("motions", i, |c| {
-                if let Some(p) = &m.parent {
-                    match motion_names.iter().position(|n| n == p) {
-                        Some(k) if k < i => {}
-                        Some(_) => {
-                            c.fail("parent", format!("parent \"{p}\" must be listed before \"{}\"", m.name))
-                        }
-                        None => c.fail(
-                            "parent",
-                            format!("parent \"{p}\" is not a motion name ({})", motion_names.join(", ")),
-                        ),
-                    }
-                }
-                if motion_names.iter().filter(|n| **n == m.name).count() > 1 {
-                    c.fail("name", format!("name \"{}\" is used by more than one motion", m.name));
-                }
-                match m.kind {
-                    MotionType::Fixed => {}
-                    MotionType::Translation => match m.velocity_m_s {
-                        Some(v) => c.finite_vec("velocity_m_s", v),
-                        None => c.fail("velocity_m_s", "a translation needs `velocity_m_s = [vx, vy, vz]`"),
-                    },
-                    MotionType::Rotation => {
-                        match m.center_m {
-                            Some(v) => c.finite_vec("center_m", v),
-                            None => c.fail("center_m", "a rotation needs `center_m = [x, y, z]`"),
-                        }
-                        match m.axis {
-                            Some(a) if a.length() > 0.0 && spatter_core::math::is_finite(a) => {}
-                            _ => c.fail("axis", "a rotation needs a non-zero `axis = [x, y, z]`"),
-                        }
-                        match m.angular_speed_rad_s {
-                            Some(w) => c.finite("angular_speed_rad_s", w),
-                            None => c.fail("angular_speed_rad_s", "a rotation needs `angular_speed_rad_s`"),
-                        }
-                    }
-                    MotionType::Table => {
-                        match &m.file {
-                            Some(f) => c.motion_table_file("file", f),
-                            None => {
-                                c.fail("file", "a table motion needs `file` (rows `t vx vy vz wx wy wz`)")
-                            }
-                        }
-                        if let Some(p) = m.reference_point_m {
-                            c.finite_vec("reference_point_m", p);
-                        }
-                    }
-                }
-            });
-        }
+        crate::motions::check_tree(c, &self.motions);
         let wall_names: Vec<&str> = self.walls.iter().map(|w| w.name.as_str()).collect();
         for (i, w) in self.walls.iter().enumerate() {
             c.element("walls", i, |c| {
                 if wall_names.iter().filter(|n| **n == w.name).count() > 1 {
                     c.fail("name", format!("name \"{}\" is used by more than one wall", w.name));
                 }
-                if let Some(m) = &w.motion {
-                    if !motion_names.contains(&m.as_str()) {
-                        c.fail("motion", format!("motion \"{m}\" is not defined in [[motions]]"));
-                    }
-                }
+                crate::motions::check_reference(c, "motion", w.motion.as_deref(), &self.motions);
                 c.non_negative("adhesion", w.adhesion);
                 if let Some(l) = w.layers {
                     if l == 0 {
