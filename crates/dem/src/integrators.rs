@@ -102,7 +102,7 @@ impl Scheme {
     }
 
     /// Past derivatives (AB, ABM) or states (BD) kept besides the current ones.
-    fn history(self) -> usize {
+    pub(crate) fn history(self) -> usize {
         match self {
             Scheme::Ab2 | Scheme::Bd2 => 1,
             Scheme::Ab4 | Scheme::Abm4 | Scheme::Bd4 => 3,

@@ -6,10 +6,10 @@
 
 #[allow(unused_imports)]
 use crate::parse::{typed, validate, ScenarioError};
-use crate::paths::absolute_paths;
 use crate::source::Source;
 use serde::Serialize;
 use spatter_core::check::Validate;
+use spatter_io::paths::absolute_paths;
 use spatter_io::run::{RunContext, RunSummary};
 use std::path::Path;
 

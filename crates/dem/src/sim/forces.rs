@@ -75,6 +75,9 @@ impl<L: ContactLaw> Simulation<L> {
     pub(crate) fn compute_forces(&mut self) {
         let t = self.st.time;
         let dt = self.dt;
+        // The time over which incremental contact springs advance (a stage of a multi-stage scheme
+        // advances them from the step start to the stage time).
+        let cdt = self.trial_dt.unwrap_or(dt);
         self.scratch.kin.clear();
         self.scratch.kin.extend(self.walls.iter().map(|w| WallKinematics::of(&w.motion, t)));
         let g = self.gravity;
@@ -206,7 +209,7 @@ impl<L: ContactLaw> Simulation<L> {
                                 i_eff: 0.4 * r * r / inv_mass[i],
                                 v_rel: vel[i] - r * omega[i].cross(n) - v_wall,
                                 w_rel: omega[i] - kw.omega,
-                                dt,
+                                dt: cdt,
                             };
                             let was_new = !out.active;
                             match law.compute(pp, &c, state) {
@@ -350,7 +353,7 @@ impl<L: ContactLaw> Simulation<L> {
                 id,
                 omega,
                 inv_mass,
-                dt,
+                dt: cdt,
                 f,
                 tq,
                 pbase,
@@ -453,6 +456,15 @@ impl<L: ContactLaw> Simulation<L> {
             )
             .unwrap_or_default();
             acc = Acc::combine(acc, a);
+        }
+
+        if self.trial_dt.is_some() {
+            // A trial stage books nothing: the step's first evaluation did.
+            self.st.last.pair_contacts = acc.pair_contacts;
+            self.st.last.wall_contacts = acc.wall_contacts;
+            self.st.last.max_overlap_ratio = acc.max_ratio;
+            self.last_worst = acc.worst;
+            return;
         }
 
         // Mesh impact records and wear (sequential: slots of different particles share triangles). The loop

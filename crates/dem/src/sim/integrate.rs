@@ -15,8 +15,70 @@ pub enum Integrator {
     /// Velocity Verlet (kick–drift–force–kick); forces see the half-step velocities. Default.
     #[default]
     VelocityVerlet,
-    /// Symplectic (semi-implicit) Euler: force, kick by Δt, drift.
+    /// Symplectic (semi-implicit) Euler: force, kick by Δt, drift (`"se"` is accepted too).
+    #[serde(alias = "se")]
     SymplecticEuler,
+    /// Forward Euler (Jasion 2013, Table A.1; first order, for studies).
+    Fe,
+    /// Explicit midpoint Runge–Kutta (2 evaluations per step).
+    Rk2,
+    /// Classical fourth-order Runge–Kutta (4 evaluations per step).
+    Rk4,
+    /// Two-step Adams–Bashforth (self-starting with RK4 steps).
+    Ab2,
+    /// Four-step Adams–Bashforth (self-starting with RK4 steps).
+    Ab4,
+    /// Adams–Bashforth–Moulton predictor–corrector, fourth order (2 evaluations per step).
+    Abm4,
+    /// Backward Euler by fixed-point iteration (`Settings::iterations` evaluations per step).
+    Bd1,
+    /// Two-step backward differentiation by fixed-point iteration.
+    Bd2,
+    /// Four-step backward differentiation by fixed-point iteration.
+    Bd4,
+}
+
+impl Integrator {
+    /// The scheme of the integrator library this integrator runs (`None` for velocity Verlet, which is
+    /// not one of the ten; symplectic Euler is the library's SE).
+    pub fn scheme(self) -> Option<crate::integrators::Scheme> {
+        use crate::integrators::Scheme;
+        Some(match self {
+            Integrator::VelocityVerlet => return None,
+            Integrator::SymplecticEuler => Scheme::Se,
+            Integrator::Fe => Scheme::Fe,
+            Integrator::Rk2 => Scheme::Rk2,
+            Integrator::Rk4 => Scheme::Rk4,
+            Integrator::Ab2 => Scheme::Ab2,
+            Integrator::Ab4 => Scheme::Ab4,
+            Integrator::Abm4 => Scheme::Abm4,
+            Integrator::Bd1 => Scheme::Bd1,
+            Integrator::Bd2 => Scheme::Bd2,
+            Integrator::Bd4 => Scheme::Bd4,
+        })
+    }
+
+    /// The integrator that runs `scheme` in a DEM scene.
+    pub fn of_scheme(scheme: crate::integrators::Scheme) -> Integrator {
+        use crate::integrators::Scheme;
+        match scheme {
+            Scheme::Fe => Integrator::Fe,
+            Scheme::Se => Integrator::SymplecticEuler,
+            Scheme::Rk2 => Integrator::Rk2,
+            Scheme::Rk4 => Integrator::Rk4,
+            Scheme::Ab2 => Integrator::Ab2,
+            Scheme::Ab4 => Integrator::Ab4,
+            Scheme::Abm4 => Integrator::Abm4,
+            Scheme::Bd1 => Integrator::Bd1,
+            Scheme::Bd2 => Integrator::Bd2,
+            Scheme::Bd4 => Integrator::Bd4,
+        }
+    }
+
+    /// Short name for tables (VV, SE, FE, RK4, …).
+    pub fn label(self) -> &'static str {
+        self.scheme().map_or("VV", |s| s.label())
+    }
 }
 
 impl<L: ContactLaw> Simulation<L> {

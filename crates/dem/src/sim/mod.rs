@@ -21,10 +21,12 @@ mod forces;
 mod impacts;
 mod integrate;
 mod neighbors;
+mod schemes;
 
 pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
+pub use schemes::{SchemeHistory, Y as SchemeState};
 
 use crate::contact::{ContactLaw, PairProps, PairTable};
 use crate::error::DemError;
@@ -56,6 +58,10 @@ pub struct Settings {
     /// bodies always rotate.
     #[serde(default = "yes")]
     pub rotation: bool,
+    /// Fixed-point iterations per step of the implicit integrators BD1, BD2, BD4 (required by them,
+    /// ≥ 1; BD-p keeps its order with ≥ p).
+    #[serde(default)]
+    pub iterations: Option<u32>,
 }
 
 fn yes() -> bool {
@@ -89,6 +95,7 @@ impl Default for Settings {
             domain: None,
             clump_contact_mass: ClumpContactMass::Body,
             rotation: true,
+            iterations: None,
         }
     }
 }
@@ -205,6 +212,9 @@ pub struct DynState<S> {
     /// Rigid bodies (clumps) whose members are in the particle store.
     #[serde(default)]
     pub bodies: crate::clump::Bodies,
+    /// Past derivatives or states of the multi-step integrators (AB2, AB4, ABM4, BD2, BD4).
+    #[serde(default)]
+    pub history: SchemeHistory,
 }
 
 impl<S> Default for DynState<S> {
@@ -225,6 +235,7 @@ impl<S> Default for DynState<S> {
             r_max: 0.0,
             energy_requested: false,
             bodies: crate::clump::Bodies::default(),
+            history: SchemeHistory::default(),
         }
     }
 }
@@ -313,6 +324,10 @@ pub struct Simulation<L: ContactLaw> {
     /// are assigned in increasing order); a blow-up at a newer particle's first evaluation means it was
     /// created overlapping.
     evaluated_ids: u32,
+    /// In a trial stage of a multi-stage integrator: the time over which contact springs advance \[s\].
+    trial_dt: Option<f64>,
+    /// Buffers of the multi-stage integrators.
+    stage: schemes::StageBuffers<L::State>,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -350,6 +365,8 @@ impl<L: ContactLaw> Simulation<L> {
             state_maybe_nonfinite: false,
             half_step_velocities: false,
             evaluated_ids: 0,
+            trial_dt: None,
+            stage: Default::default(),
         }
     }
 
@@ -598,6 +615,11 @@ impl<L: ContactLaw> Simulation<L> {
                 // Forces now belong to the previous positions.
                 self.st.forces_valid = false;
             }
+            other => {
+                if let Some(scheme) = other.scheme() {
+                    self.scheme_step(scheme)?;
+                }
+            }
         }
         self.st.step += 1;
         self.st.energy_requested = false;
@@ -750,6 +772,8 @@ impl<L: ContactLaw> Simulation<L> {
 mod clump_tests;
 #[cfg(test)]
 mod contact_option_tests;
+#[cfg(test)]
+mod scheme_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -10,7 +10,13 @@ use spatter_core::motion::Motion;
 use spatter_core::rng::seeded;
 
 /// Six planes around the box [0, l]³ (material `mat`), optionally with the floor as a mesh.
-fn box_walls<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, mat: u16, floor_mat: u16, mesh_floor: bool) {
+pub(super) fn box_walls<L: ContactLaw>(
+    sim: &mut Simulation<L>,
+    l: f64,
+    mat: u16,
+    floor_mat: u16,
+    mesh_floor: bool,
+) {
     let planes = [
         (Vec3::ZERO, Vec3::X),
         (Vec3::splat(l), -Vec3::X),
@@ -37,11 +43,18 @@ fn box_walls<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, mat: u16, floor_mat
     sim.add_wall(Wall { name: "floor".into(), shape: floor, material: floor_mat, motion: Motion::Fixed });
 }
 
-fn soft() -> Material {
+pub(super) fn soft() -> Material {
     Material::new(5e7, 0.3, 2500.0).unwrap()
 }
 
-fn fill<L: ContactLaw>(sim: &mut Simulation<L>, l: f64, n: u64, d: (f64, f64), speed: f64, seed: u64) {
+pub(super) fn fill<L: ContactLaw>(
+    sim: &mut Simulation<L>,
+    l: f64,
+    n: u64,
+    d: (f64, f64),
+    speed: f64,
+    seed: u64,
+) {
     let mut rng = seeded(seed, 0);
     let got = crate::validation::bulk::draw_order_fill(l, d, n, &mut rng);
     assert_eq!(got.len() as u64, n);
@@ -528,8 +541,8 @@ fn residual_energy_method_accounts_for_inserted_and_removed_particles() {
 /// δ₀ = 1e-4 m at the centre position, with a constant-stiffness Hooke law (k = 1e5 N/m), no damping,
 /// no friction, no gravity: for displacements below δ₀ both contacts stay closed and the net force is
 /// exactly −2k x, a harmonic oscillator with ω = √(2k/m). Starts at x = A = 5e-5 m at rest and records
-/// (x, v) after every step.
-fn sandwiched_oscillator(
+/// (x, v) after every step. The implicit integrators iterate 5 times.
+pub(super) fn sandwiched_oscillator(
     integrator: Integrator,
     steps_per_period: usize,
     periods: f64,
@@ -543,7 +556,7 @@ fn sandwiched_oscillator(
     let mats = vec![Material::new(5e7, 0.3, rho).unwrap()];
     let law =
         Composed::new(Hooke { stiffness: HookeStiffness::Constant(k) }, NoDamping, Frictionless, NoRolling);
-    let settings = Settings { integrator, ..Settings::default() };
+    let settings = Settings { integrator, iterations: Some(5), ..Settings::default() };
     let mut sim = Simulation::new(law, mats.clone(), uniform_pairs(&mats, 0.0, 1.0), dt, settings);
     let h = 2.0 * (r - d0);
     for (p, n) in [(Vec3::ZERO, Vec3::Z), (Vec3::new(0.0, 0.0, h), -Vec3::Z)] {

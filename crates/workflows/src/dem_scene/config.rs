@@ -13,7 +13,7 @@ use spatter_dem::contact::RestitutionCalibration;
 use spatter_dem::insertion::Lattice;
 use spatter_dem::sim::Integrator;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A DEM scene: materials, pairs, walls, particles, time stepping and outputs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,10 +60,6 @@ pub struct SceneConfig {
     pub wear: Vec<WearConfig>,
     #[serde(default)]
     pub output: OutputConfig,
-    /// Folder that relative file paths (meshes, motion tables) are resolved against; set by the loader
-    /// to the scenario file's folder (the working directory when unset).
-    #[serde(skip)]
-    pub base_dir: Option<PathBuf>,
 }
 
 fn default_output_interval() -> f64 {
@@ -197,9 +193,13 @@ impl TangentialKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EngineConfig {
-    /// `velocity_verlet` (default) or `symplectic_euler`.
+    /// `velocity_verlet` (default), `symplectic_euler` (or `se`), or one of the study schemes `fe`,
+    /// `rk2`, `rk4`, `ab2`, `ab4`, `abm4`, `bd1`, `bd2`, `bd4` (spheres only).
     #[serde(default)]
     pub integrator: Integrator,
+    /// Fixed-point iterations per step of the implicit `bd1`, `bd2`, `bd4` (required by them, ≥ 1).
+    #[serde(default)]
+    pub iterations: Option<u32>,
     /// Verlet skin \[m\] (default 10 % of the largest diameter).
     #[serde(default)]
     pub skin_m: Option<f64>,
@@ -248,6 +248,7 @@ impl Default for EngineConfig {
     fn default() -> Self {
         EngineConfig {
             integrator: Integrator::VelocityVerlet,
+            iterations: None,
             skin_m: None,
             verlet_list: true,
             max_overlap_fraction: default_overlap_fraction(),
@@ -565,14 +566,6 @@ impl Default for OutputConfig {
 }
 
 impl SceneConfig {
-    /// Resolves a path from the file against [`SceneConfig::base_dir`].
-    pub fn resolve(&self, p: &Path) -> PathBuf {
-        match &self.base_dir {
-            Some(b) if p.is_relative() => b.join(p),
-            _ => p.to_owned(),
-        }
-    }
-
     /// Material names in index order (the order of the `materials` table).
     pub fn material_names(&self) -> Vec<&str> {
         self.materials.keys().map(String::as_str).collect()
@@ -827,6 +820,35 @@ impl Validate for SceneConfig {
             }
             if let Some(v) = e.impact_speed_m_s {
                 c.positive("impact_speed_m_s", v);
+            }
+            if let Some(scheme) = e.integrator.scheme() {
+                if scheme.is_implicit() && e.iterations.unwrap_or(0) == 0 {
+                    c.fail(
+                        "iterations",
+                        format!(
+                            "integrator = \"{}\" is implicit and needs iterations ≥ 1 (fixed-point iterations \
+                             per step; BD-p keeps its order with ≥ p, e.g. iterations = {})",
+                            e.integrator.label().to_lowercase(),
+                            scheme.nominal_order() + 1
+                        ),
+                    );
+                }
+                if scheme != spatter_dem::integrators::Scheme::Se && !self.templates.is_empty() {
+                    c.fail(
+                        "integrator",
+                        format!(
+                            "integrator = \"{}\" runs single spheres only; this scene has clump templates — \
+                             use \"velocity_verlet\" or \"symplectic_euler\"",
+                            e.integrator.label().to_lowercase()
+                        ),
+                    );
+                }
+            }
+            if e.iterations.is_some() && !e.integrator.scheme().is_some_and(|s| s.is_implicit()) {
+                c.fail(
+                    "iterations",
+                    "iterations applies to the implicit integrators bd1, bd2, bd4 only; remove it".to_string(),
+                );
             }
             if !e.rotation && !self.templates.is_empty() {
                 c.fail(

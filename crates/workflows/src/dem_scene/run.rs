@@ -21,7 +21,7 @@ use spatter_dem::sim::{SimState, Simulation};
 use spatter_dem::timestep;
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 
 /// Everything a resumed run needs (the checkpoint header names the input it belongs to: a resume with
 /// another scene is refused when it is loaded).
@@ -102,7 +102,7 @@ pub fn run_collect(
     cfg: &SceneConfig,
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
-    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
+    Checker::run(cfg, None).map_err(DemError::Invalid)?;
     with_law(cfg, SceneRun { cfg, ctx })
 }
 
@@ -340,6 +340,7 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
         },
         clump_contact_mass: e.clump_contact_mass,
         rotation: e.rotation,
+        iterations: e.iterations,
     };
     let mut sim = Simulation::new(law, built.materials, built.pairs, cfg.dt_s, settings);
     sim.energy_method =
@@ -542,8 +543,10 @@ fn run_with<L: ContactLaw>(
     if cfg.output.trajectories.is_some() {
         s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
     }
-    for (name, png) in write_wear_maps(&sim, ctx)? {
+    for (name, png, record) in write_wear_maps(&sim, ctx)? {
         s.artifacts.push((format!("eroded mass map {name}"), png));
+        s.artifacts.push((format!("eroded mass per triangle {name} (VTU)"), record.vtu.clone()));
+        s.maps.push(record);
     }
     let r = results(&sim, events);
     Ok((s, Some(r)))
@@ -571,11 +574,14 @@ fn write_events<L: ContactLaw>(
 
 /// For every mesh wall that a wear model applies to, `wear/<name>_eroded_mass.png`: the eroded mass per
 /// triangle at the end of the run, seen against the wall's area-weighted mean normal (the side the
-/// particles hit), with the global z axis (or y for a horizontal wall) towards the top.
+/// particles hit), with the global z axis (or y for a horizontal wall) towards the top; and
+/// `wear/<name>_eroded_mass.vtu`, the wall in its final pose with the cell array `eroded_mass_kg` the picture
+/// shows. Returns (wall name, picture, map record); the record lets a study redraw the map of every case on
+/// one colour scale.
 fn write_wear_maps<L: ContactLaw>(
     sim: &Simulation<L>,
     ctx: &RunContext,
-) -> Result<Vec<(String, std::path::PathBuf)>, DemError> {
+) -> Result<Vec<(String, std::path::PathBuf, MeshMapRecord)>, DemError> {
     let mut out = Vec::new();
     let mats = sim.materials().len();
     for wall in &sim.walls {
@@ -590,18 +596,26 @@ fn write_wear_maps<L: ContactLaw>(
         let view = -n.normalize_or_zero();
         let up = if view.cross(Vec3::Z).length() > 1e-3 { Vec3::Z } else { Vec3::Y };
         let name = &wall.name;
+        let vtu = ctx.dir.path(&format!("wear/{name}_eroded_mass.vtu"));
+        spatter_io::vtu::Vtu::triangles(&mesh.vertices, &mesh.triangles)
+            .cell_scalar("eroded_mass_kg", &m.records.eroded_mass)
+            .write(&vtu)
+            .map_err(|source| DemError::Io { path: vtu.clone(), source })?;
         let png = ctx.dir.path(&format!("wear/{name}_eroded_mass.png"));
-        spatter_io::plot::mesh_map_png(
-            &png,
-            &mesh,
-            &m.records.eroded_mass,
-            view,
-            up,
-            &format!("{name}: eroded mass per triangle ({})", sim.wear().names().join(", ")),
-            "eroded mass [kg]",
-        )
-        .map_err(|source| DemError::Io { path: png.clone(), source })?;
-        out.push((name.clone(), png));
+        let title = format!("{name}: eroded mass per triangle ({})", sim.wear().names().join(", "));
+        let colorbar = "eroded mass [kg]";
+        spatter_io::plot::mesh_map_png(&png, &mesh, &m.records.eroded_mass, view, up, &title, colorbar)
+            .map_err(|source| DemError::Io { path: png.clone(), source })?;
+        let record = MeshMapRecord {
+            label: format!("{name} eroded mass"),
+            vtu,
+            array: "eroded_mass_kg".into(),
+            view_dir: view.to_array(),
+            up: up.to_array(),
+            title,
+            colorbar_label: colorbar.into(),
+        };
+        out.push((name.clone(), png, record));
     }
     Ok(out)
 }
@@ -685,7 +699,7 @@ pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulat
             b = b.grown_to(*x);
         }
         for j in &cfg.inject {
-            if let Ok(r) = setup::region(cfg, &j.region) {
+            if let Ok(r) = setup::region(&j.region) {
                 b = b.union(r.bounds());
             }
         }
