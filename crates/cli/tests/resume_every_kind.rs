@@ -245,6 +245,22 @@ fn flow_resumes_bit_for_bit() {
     stop_and_resume(&s, 40, "flow");
 }
 
+#[test]
+fn cfd_dem_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    // The fluidised-bed example with 150 beads for 30 coupling steps, snapshots and samples inside.
+    let text = std::fs::read_to_string(examples.join("cfd_dem_fluidised_bed.toml"))
+        .unwrap()
+        .replace("count = 3000", "count = 150")
+        .replace("duration_s = 0.6", "duration_s = 0.0012")
+        .replace("field_interval_s = 0.025", "field_interval_s = 0.0004")
+        .replace("sample_interval_s = 0.005", "sample_interval_s = 0.0001");
+    assert!(text.contains("count = 150") && text.contains("duration_s = 0.0012"));
+    let s = write(dir.path(), "cfd_dem.toml", text.as_bytes());
+    stop_and_resume(&s, 17, "cfd_dem");
+}
+
 /// A real SIGTERM (what a batch scheduler sends) to a child `spatter run`: it finishes the step, writes
 /// a checkpoint, exits 130, and `--resume` completes the run with the same files as an uninterrupted one.
 #[cfg(unix)]

@@ -15,6 +15,7 @@
 
 pub mod checkpoint;
 pub mod csv;
+pub mod paths;
 pub mod plot;
 pub mod pvd;
 pub mod report;

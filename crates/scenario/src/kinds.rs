@@ -6,10 +6,10 @@
 
 #[allow(unused_imports)]
 use crate::parse::{typed, validate, ScenarioError};
-use crate::paths::absolute_paths;
 use crate::source::Source;
 use serde::Serialize;
 use spatter_core::check::Validate;
+use spatter_io::paths::absolute_paths;
 use spatter_io::run::{RunContext, RunSummary};
 use std::path::Path;
 
@@ -80,6 +80,8 @@ kinds! {
         "A vehicle of named STL parts driving through a generated wading channel: wetting per part, sensors, splash heights.";
     "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run),
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
+    "cfd_dem" => CfdDem(spatter_workflows::cfd_dem::CfdDemConfig, spatter_workflows::cfd_dem::run),
+        "Flow on a Cartesian grid coupled two-way to a DEM scene (volume-averaged CFD-DEM): fluidised and fixed beds, settling.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
     "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run),

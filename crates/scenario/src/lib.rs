@@ -15,7 +15,6 @@
 pub mod job;
 pub mod kinds;
 pub mod parse;
-pub mod paths;
 pub mod source;
 
 pub use kinds::{load, load_str, Loaded, Scenario, KINDS};

@@ -30,8 +30,11 @@ fn main() {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let body: String =
         text.lines().filter(|l| !l.trim_start().starts_with("kind")).collect::<Vec<_>>().join("\n");
-    let mut cfg: SceneConfig = toml::from_str(&body).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    cfg.base_dir = path.parent().map(Path::to_owned);
+    let cfg: SceneConfig = toml::from_str(&body).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // Relative file paths are relative to the scenario's folder, as for `spatter run`.
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let cfg =
+        spatter_io::paths::absolute_paths(cfg, folder).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let dir = RunDir::create(Path::new(&args[2])).expect("output folder");
     let resume = args.iter().any(|a| a == "--resume");
     let t = std::time::Instant::now();

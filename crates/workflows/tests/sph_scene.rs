@@ -79,6 +79,12 @@ fn a_run_writes_every_output() {
     assert!(!tmp.path().join("log.txt").exists(), "the scene writes no log.txt itself");
     let cost = summary.headline.iter().find(|l| l.contains("run cost:")).expect("a run-cost line");
     assert!(cost.contains("core-hours"), "{cost}");
+    // The wetting picture is recorded for a study's gallery: its squares and values, each in [0, 1].
+    let map = summary.maps.iter().find(|m| m.label == "tank wetting").expect("wetting map recorded");
+    let squares = spatter_io::vtk::read(&map.vtu).unwrap();
+    let fraction = &squares.cell_array(&map.array).unwrap().values;
+    assert_eq!(fraction.len() * 3, squares.connectivity.len());
+    assert!(fraction.iter().all(|f| (0.0..=1.0).contains(f)) && fraction.iter().any(|&f| f > 0.0));
     assert!(!tmp.path().join("checkpoint.bin").exists(), "a finished run leaves no checkpoint");
 }
 
@@ -503,7 +509,7 @@ fn adhesion_outside_the_calibrated_range_is_warned_about() {
     };
     for (st, f, warned) in [(0.072, 10.0, true), (0.072, 1.0, false), (0.0, 10.0, false)] {
         let cfg = config(&with(st, f));
-        let (_, info) = build(&cfg, Path::new(".")).unwrap();
+        let (_, info) = build(&cfg).unwrap();
         let line = "wall `tank`: adhesion 10 is above the calibrated range 0.75–3";
         assert_eq!(
             info.warnings.iter().any(|w| w.starts_with(line)),

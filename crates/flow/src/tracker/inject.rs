@@ -14,7 +14,7 @@ use spatter_core::distribution::SizeDistribution;
 use spatter_core::mesh::TriMesh;
 use spatter_core::rng::{seeded, Rng, RngExt};
 use spatter_core::Vec3;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Where parcels start.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -191,11 +191,12 @@ pub struct InjectError {
 }
 
 impl Injector {
-    /// Prepares injector number `index` (its random stream); surface files are read relative to `base`.
-    pub fn new(spec: InjectorSpec, index: u64, base: Option<&Path>) -> Result<Self, InjectError> {
+    /// Prepares injector number `index` (its random stream) and reads its surface file, if any (a relative
+    /// path is relative to the working directory; the scenario loader has made it absolute).
+    pub fn new(spec: InjectorSpec, index: u64) -> Result<Self, InjectError> {
         let rng = seeded(spec.seed, 0x1000 + index);
         let mut inj = Injector { spec, released: 0, rng, surface: None };
-        inj.load_surface(base)?;
+        inj.load_surface()?;
         Ok(inj)
     }
 
@@ -211,13 +212,9 @@ impl Injector {
     }
 
     /// Reads the surface of a surface injector.
-    pub fn load_surface(&mut self, base: Option<&Path>) -> Result<(), InjectError> {
+    pub fn load_surface(&mut self) -> Result<(), InjectError> {
         if let Region::Surface { file, scale, .. } = &self.spec.region {
-            let path = match base {
-                Some(b) if file.is_relative() => b.join(file),
-                _ => file.clone(),
-            };
-            let mesh = TriMesh::load(&path, *scale)
+            let mesh = TriMesh::load(file, *scale)
                 .map_err(|e| InjectError { name: self.spec.name.clone(), message: e.to_string() })?;
             let mut cdf = Vec::with_capacity(mesh.triangles.len());
             let mut acc = 0.0;
@@ -340,8 +337,7 @@ mod tests {
 
     #[test]
     fn release_schedule_and_mass_flow() {
-        let mut inj =
-            Injector::new(spec(Region::Box { min_m: Vec3::ZERO, max_m: Vec3::ONE }), 0, None).unwrap();
+        let mut inj = Injector::new(spec(Region::Box { min_m: Vec3::ZERO, max_m: Vec3::ONE }), 0).unwrap();
         let mut got = Vec::new();
         inj.release(0.05, |p| got.push(p));
         assert!(got.is_empty());
@@ -371,12 +367,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("plate.stl");
         std::fs::write(&path, TriMesh::rectangle(2.0, 1.0, 0.0, 4, 2).to_binary_stl()).unwrap();
-        let mut s = spec(Region::Surface { file: "plate.stl".into(), scale: 1.0, offset_m: 1e-3 });
+        let mut s = spec(Region::Surface { file: path, scale: 1.0, offset_m: 1e-3 });
         s.normal_speed = 2.0;
         s.start_s = 0.0;
         s.end_s = 0.0;
         s.mass_flow_kg_s = None;
-        let mut inj = Injector::new(s, 0, Some(dir.path())).unwrap_or_else(|e| panic!("{e}"));
+        let mut inj = Injector::new(s, 0).unwrap_or_else(|e| panic!("{e}"));
         let mut got = Vec::new();
         inj.release(0.0, |p| got.push(p));
         assert_eq!(got.len(), 100);

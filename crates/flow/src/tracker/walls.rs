@@ -136,18 +136,15 @@ pub fn load_regime_map(path: &std::path::Path) -> Result<RegimeMap, WallRuleErro
 }
 
 impl WallRule {
-    /// Loads the rule, reading a regime map relative to `base` (the scenario's folder) when needed.
-    pub fn from_spec(spec: &WallRuleSpec, base: Option<&std::path::Path>) -> Result<Self, WallRuleError> {
+    /// Loads the rule, reading its regime map file when it has one (a relative path is relative to the
+    /// working directory; the scenario loader has made it absolute).
+    pub fn from_spec(spec: &WallRuleSpec) -> Result<Self, WallRuleError> {
         Ok(match spec {
             WallRuleSpec::Reflect { restitution } => WallRule::Reflect(*restitution),
             WallRuleSpec::Trap => WallRule::Trap,
             WallRuleSpec::Escape => WallRule::Escape,
             WallRuleSpec::RegimeMap { file, bounce, max_tangential_speed_m_s, max_wall_shear_pa } => {
-                let path = match base {
-                    Some(b) if file.is_relative() => b.join(file),
-                    _ => file.clone(),
-                };
-                let map = load_regime_map(&path)?;
+                let map = load_regime_map(file)?;
                 WallRule::RegimeMap {
                     map,
                     bounce: *bounce,
@@ -369,28 +366,28 @@ mod tests {
         let p = dir.path().join("map.json");
         std::fs::write(&p, serde_json::to_string(&test_map(1.0)).unwrap()).unwrap();
         let spec = WallRuleSpec::RegimeMap {
-            file: "map.json".into(),
+            file: p.clone(),
             bounce: Restitution::default(),
             max_tangential_speed_m_s: None,
             max_wall_shear_pa: None,
         };
-        assert!(WallRule::from_spec(&spec, Some(dir.path())).is_ok());
+        assert!(WallRule::from_spec(&spec).is_ok());
         let mut bad = test_map(1.0);
         bad.schema = "other".into();
         std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
-        let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
+        let e = WallRule::from_spec(&spec).unwrap_err().to_string();
         assert!(e.contains("map.json") && e.contains("spatter.regime_map.v1"), "{e}");
         // A reversed diameter range (used to panic in the clamp of every impact) and an empty
         // coefficient list (used to give v_crit = 10⁰ = 1 m/s silently) are refused with file and key.
         let mut bad = test_map(1.0);
         bad.v_crit_of_d.x_range = [1e-3, 1e-6];
         std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
-        let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
+        let e = WallRule::from_spec(&spec).unwrap_err().to_string();
         assert!(e.contains("map.json") && e.contains("v_crit_of_d.x_range"), "{e}");
         let mut bad = test_map(1.0);
         bad.v_crit_of_d.coefficients.clear();
         std::fs::write(&p, serde_json::to_string(&bad).unwrap()).unwrap();
-        let e = WallRule::from_spec(&spec, Some(dir.path())).unwrap_err().to_string();
+        let e = WallRule::from_spec(&spec).unwrap_err().to_string();
         assert!(e.contains("map.json") && e.contains("v_crit_of_d.coefficients"), "{e}");
     }
 }

@@ -6,7 +6,7 @@
 //! `OFFSETS` and `CONNECTIVITY` arrays; older versions as one `n id…` row per cell. `METADATA` blocks are
 //! skipped.
 
-use super::{cell_type, DataArray, VtkDataset, VtkError};
+use super::{cell_type, lattice, DataArray, VtkDataset, VtkError};
 use spatter_core::Vec3;
 use std::path::Path;
 
@@ -431,18 +431,6 @@ fn read_field_array(c: &mut Cursor) -> Result<DataArray, VtkError> {
     let values = c.numbers(comps * tuples, &ty)?;
     c.skip_metadata();
     Ok(DataArray { name, components: comps, values })
-}
-
-fn lattice(dims: [usize; 3], f: impl Fn(usize, usize, usize) -> Vec3) -> Vec<Vec3> {
-    let mut v = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                v.push(f(i, j, k));
-            }
-        }
-    }
-    v
 }
 
 /// Splits pre-5.0 `CELLS` rows (`n id…`, or `n n_faces (n_i id…)…` for polyhedra).

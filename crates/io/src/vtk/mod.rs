@@ -252,3 +252,16 @@ pub fn read(path: &Path) -> Result<VtkDataset, VtkError> {
     ds.check(path)?;
     Ok(ds)
 }
+
+/// The points of a structured lattice of `dims` points, x fastest then y then z (VTK's order), placed by `f(i, j, k)`.
+pub(crate) fn lattice(dims: [usize; 3], f: impl Fn(usize, usize, usize) -> Vec3) -> Vec<Vec3> {
+    let mut v = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                v.push(f(i, j, k));
+            }
+        }
+    }
+    v
+}

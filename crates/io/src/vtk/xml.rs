@@ -10,7 +10,7 @@
 //! Polyhedra: the `faces`/`faceoffsets` arrays (VTK ≤ 9.3) or `face_connectivity`/`face_offsets`/
 //! `polyhedron_to_faces`/`polyhedron_offsets` (VTK ≥ 9.4).
 
-use super::{cell_type, DataArray, VtkDataset, VtkError};
+use super::{cell_type, lattice, DataArray, VtkDataset, VtkError};
 use base64::Engine;
 use quick_xml::events::Event;
 use spatter_core::Vec3;
@@ -509,18 +509,6 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<VtkDataset, VtkError> {
 
 fn dims_of(e: [i64; 6]) -> [usize; 3] {
     [(e[1] - e[0] + 1).max(0) as usize, (e[3] - e[2] + 1).max(0) as usize, (e[5] - e[4] + 1).max(0) as usize]
-}
-
-fn lattice(dims: [usize; 3], f: impl Fn(usize, usize, usize) -> Vec3) -> Vec<Vec3> {
-    let mut v = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                v.push(f(i, j, k));
-            }
-        }
-    }
-    v
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -7,4 +7,4 @@ pub mod run;
 
 pub use config::FlowConfig;
 pub use field::{AxisFrame, SolvedField};
-pub use run::{build, run, FlowRunError};
+pub use run::{build, build_domain, run, FlowDomain, FlowRunError};

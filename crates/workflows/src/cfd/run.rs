@@ -16,7 +16,9 @@
 //! A resumed run continues from `checkpoint.bin` and writes the same files, bit for bit, as an
 //! uninterrupted one (the solver state, the output clocks and the file lengths are in the checkpoint).
 
-use super::config::{CutNormal, FlowConfig};
+use super::config::{
+    BoundariesSpec, CutNormal, FlowConfig, FluidSpec, GridSpec, NumericsSpec, TurbulenceSpec,
+};
 use serde::{Deserialize, Serialize};
 use spatter_cfd::grid::Grid;
 use spatter_cfd::output::{axis_names, kinetic_energy, probe, speed_slice, to_vtr};
@@ -46,21 +48,49 @@ pub enum FlowRunError {
     Checkpoint(#[from] spatter_io::checkpoint::CheckpointError),
 }
 
-fn io_at(path: &Path) -> impl Fn(std::io::Error) -> FlowRunError + '_ {
+pub(crate) fn io_at(path: &Path) -> impl Fn(std::io::Error) -> FlowRunError + '_ {
     move |e| FlowRunError::Io(format!("{}: {e}", path.display()))
 }
 
-/// Builds the flow of a scenario (grid, blocked cells, boundaries, numerics), at rest.
+/// Builds the flow of a scenario (grid, blocked cells, boundaries, numerics, turbulence, actuator disks),
+/// at rest.
 pub fn build(cfg: &FlowConfig) -> Result<Flow, FlowRunError> {
-    let g = &cfg.grid;
+    let mut flow = build_domain(&FlowDomain {
+        fluid: &cfg.fluid,
+        grid: &cfg.grid,
+        boundaries: &cfg.boundaries,
+        solids: &cfg.solids,
+        turbulence: &cfg.turbulence,
+        numerics: &cfg.numerics,
+    })?;
+    for (i, d) in cfg.actuator_disks.iter().enumerate() {
+        flow.add_actuator_disk(d).map_err(|e| FlowRunError::Setup(format!("actuator_disks[{i}]: {e}")))?;
+    }
+    Ok(flow)
+}
+
+/// The tables of a scenario that describe the fluid and its domain, shared by the `flow` and `cfd_dem`
+/// kinds (same keys, same meaning).
+pub struct FlowDomain<'a> {
+    pub fluid: &'a FluidSpec,
+    pub grid: &'a GridSpec,
+    pub boundaries: &'a BoundariesSpec,
+    pub solids: &'a [spatter_cfd::solid::Solid],
+    pub turbulence: &'a TurbulenceSpec,
+    pub numerics: &'a NumericsSpec,
+}
+
+/// Builds the flow of `d` (grid, blocked cells, boundaries, numerics, turbulence model), at rest.
+pub fn build_domain(d: &FlowDomain) -> Result<Flow, FlowRunError> {
+    let g = d.grid;
     let axis = |name: &str, a: &super::config::AxisSpec| {
         a.axis().map_err(|e| FlowRunError::Setup(format!("grid.{name}: {e}")))
     };
     let grid = Grid::new([axis("x", &g.x)?, axis("y", &g.y)?, axis("z", &g.z_axis())?], g.mode)
         .map_err(|e| FlowRunError::Setup(format!("grid: {e}")))?;
-    let blocked = spatter_cfd::solid::blocked_cells(&grid, &cfg.solids)
-        .map_err(|e| FlowRunError::Setup(e.to_string()))?;
-    let n = &cfg.numerics;
+    let blocked =
+        spatter_cfd::solid::blocked_cells(&grid, d.solids).map_err(|e| FlowRunError::Setup(e.to_string()))?;
+    let n = d.numerics;
     let numerics = Numerics {
         convection: n.convection,
         pressure: PcgSettings {
@@ -70,13 +100,9 @@ pub fn build(cfg: &FlowConfig) -> Result<Flow, FlowRunError> {
         },
         max_courant: n.max_courant,
     };
-    let fluid = Fluid { density: cfg.fluid.density_kg_m3, viscosity: cfg.fluid.kinematic_viscosity_m2_s };
-    let mut flow = Flow::new(grid, fluid, cfg.boundaries.sides(), blocked, numerics)?;
-    for (i, d) in cfg.actuator_disks.iter().enumerate() {
-        flow.add_actuator_disk(d).map_err(|e| FlowRunError::Setup(format!("actuator_disks[{i}]: {e}")))?;
-    }
-    if let super::config::TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = cfg.turbulence
-    {
+    let fluid = Fluid { density: d.fluid.density_kg_m3, viscosity: d.fluid.kinematic_viscosity_m2_s };
+    let mut flow = Flow::new(grid, fluid, d.boundaries.sides(), blocked, numerics)?;
+    if let TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = *d.turbulence {
         flow.enable_k_epsilon(spatter_cfd::turbulence::KEpsilon::standard(
             inlet_intensity,
             inlet_length_scale_m,
@@ -130,7 +156,7 @@ fn probe_columns(cfg: &FlowConfig) -> Vec<String> {
     c
 }
 
-fn max_speed(flow: &Flow) -> f64 {
+pub(crate) fn max_speed(flow: &Flow) -> f64 {
     let l = flow.grid.layout;
     let mut m: f64 = 0.0;
     for k in 0..l.n[2] {

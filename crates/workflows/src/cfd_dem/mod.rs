@@ -25,15 +25,19 @@
 //! The solver's pressure p excludes the hydrostatic part ρ_f g·x; its force on a sphere, Archimedes'
 //! −ρ_f V g, is added to every sphere and balanced by the hydrostatic pressure, so it is not exchanged.
 
+pub mod config;
 pub mod exchange;
+pub mod run;
 #[cfg(test)]
 mod tests;
 pub mod validation;
 pub mod void_fraction;
 
 use crate::fluid_forces::{FluidForceOptions, FluidSampler};
+pub use config::CfdDemConfig;
 use exchange::{pressure_gradient_nodes, GridFluid};
 use rayon::prelude::*;
+pub use run::{run, CfdDemError};
 use serde::{Deserialize, Serialize};
 use spatter_cfd::{Flow, FlowError, Mode};
 use spatter_core::check::{Checker, Validate};
@@ -135,6 +139,12 @@ pub struct CouplingTimes {
 pub enum CouplingError {
     #[error("CFD–DEM coupling needs a Cartesian grid (the axisymmetric mode has no 3D particle cells)")]
     NotCartesian,
+    #[error(
+        "the fluid step Δt_f = dem_steps_per_fluid_step × DEM step = {dt:e} s exceeds the explicit \
+         diffusion limit {limit:e} s of the flow solver (1/(4 ν Σ 1/Δx²), second-order Adams–Bashforth) \
+         at t = {t} s; lower dem_steps_per_fluid_step or the DEM time step"
+    )]
+    FluidStep { dt: f64, limit: f64, t: f64 },
     #[error("fluid: {0}")]
     Flow(#[from] FlowError),
     #[error("DEM: {0}")]
@@ -163,8 +173,11 @@ impl<L: ContactLaw> Coupled<L> {
         if flow.grid.mode != Mode::Cartesian {
             return Err(CouplingError::NotCartesian);
         }
-        options.forces.fluid =
-            spatter_flow::forces::Fluid { density: flow.fluid.density, viscosity: flow.fluid.viscosity };
+        // The flow carries the kinematic viscosity ν, the force laws the dynamic one μ = ρ ν.
+        options.forces.fluid = spatter_flow::forces::Fluid {
+            density: flow.fluid.density,
+            viscosity: flow.fluid.density * flow.fluid.viscosity,
+        };
         let void_fraction = VoidFraction::new(&flow.grid, options.void_fraction, options.alpha_min);
         Ok(Coupled {
             flow,
@@ -273,15 +286,28 @@ impl<L: ContactLaw> Coupled<L> {
 
     /// One coupling step: exchange, one fluid step of Δt_f, N DEM steps.
     pub fn step(&mut self) -> Result<ExchangeReport, CouplingError> {
-        let rep = self.exchange();
+        self.step_reporting().map(|(rep, _)| rep)
+    }
+
+    /// Like [`Coupled::step`], also returning the fluid step's report (Courant number, pressure solve).
+    pub fn step_reporting(
+        &mut self,
+    ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
         let dt = self.fluid_dt();
+        // The fixed fluid step must respect the explicit diffusion limit (with k–ε it moves with ν_t).
+        // stable_dt returns 0.9 of the limit.
+        let limit = self.flow.stable_dt(f64::INFINITY, f64::INFINITY) / 0.9;
+        if dt > limit {
+            return Err(CouplingError::FluidStep { dt, limit, t: self.flow.state.t });
+        }
+        let rep = self.exchange();
         let t0 = Instant::now();
-        self.flow.step(dt)?;
+        let frep = self.flow.step(dt)?;
         let t1 = Instant::now();
         self.dem.run_steps(self.options.dem_steps_per_fluid_step as u64)?;
         let t2 = Instant::now();
         self.times.fluid += (t1 - t0).as_secs_f64();
         self.times.dem += (t2 - t1).as_secs_f64();
-        Ok(rep)
+        Ok((rep, frep))
     }
 }

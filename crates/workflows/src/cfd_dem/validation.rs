@@ -1,6 +1,7 @@
 //! Reference cases of the CFD–DEM coupling for `spatter validate` (their fast forms run as unit tests):
 //! the pressure gradient through a fixed bed against Ergun (1952) and a sphere settling with two-way
-//! coupling against the Schiller & Naumann (1933) terminal velocity.
+//! coupling against the Schiller & Naumann (1933) terminal velocity, and the minimum fluidisation
+//! velocity of a small bed against Wen & Yu (1966).
 
 use super::*;
 use crate::fluid_forces::DragModel;
@@ -18,13 +19,15 @@ pub fn validation_cases() -> Vec<Case> {
     vec![
         Case { name: "cfd_dem_ergun_fixed_bed", run: ergun_case },
         Case { name: "cfd_dem_settling_sphere", run: settling_case },
+        Case { name: "cfd_dem_minimum_fluidisation", run: fluidisation_case },
     ]
 }
 
 pub(crate) const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
+/// Water: ρ = 1000 kg/m³, ν = 10⁻⁶ m²/s (μ = 10⁻³ Pa s).
 pub(crate) fn water() -> Fluid {
-    Fluid { density: 1000.0, viscosity: 1e-3 }
+    Fluid { density: 1000.0, viscosity: 1e-6 }
 }
 
 /// A DEM of glass spheres (ρ = 2500 kg/m³, soft) under gravity.
@@ -53,9 +56,10 @@ pub(crate) fn flow(n: [usize; 3], h: f64, bc: [Boundary; 6]) -> Result<Flow, Str
     Flow::new(g, water(), bc, vec![false; len], Numerics::default()).map_err(|e| e.to_string())
 }
 
-/// Ergun (1952), Chem. Eng. Prog. 48:89–94: Δp/L = 150 μ (1−ε)² U/(ε³ d²) + 1.75 ρ (1−ε) U²/(ε³ d).
+/// Ergun (1952), Chem. Eng. Prog. 48:89–94: Δp/L = 150 μ (1−ε)² U/(ε³ d²) + 1.75 ρ (1−ε) U²/(ε³ d),
+/// μ = ρ ν.
 pub(crate) fn ergun(eps: f64, u: f64, d: f64, f: &Fluid) -> f64 {
-    150.0 * f.viscosity * (1.0 - eps).powi(2) * u / (eps.powi(3) * d * d)
+    150.0 * f.density * f.viscosity * (1.0 - eps).powi(2) * u / (eps.powi(3) * d * d)
         + 1.75 * f.density * (1.0 - eps) * u * u / (eps.powi(3) * d)
 }
 
@@ -185,4 +189,244 @@ fn settling_case(quick: bool) -> Vec<Check> {
             Check::relative(c, format!("settling speed, model {model:?} [m/s]"), wt, v, 0.03, src)
         })
         .collect()
+}
+
+/// Wen & Yu (1966), Chem. Eng. Prog. Symp. Ser. 62(62):100–111: the particle Reynolds number at minimum
+/// fluidisation Re_mf = √(33.7² + 0.0408 Ar) − 33.7 with Ar = ρ_f (ρ_p − ρ_f) g d³/μ²; returns
+/// U_mf = Re_mf μ/(ρ_f d) \[m/s\] (μ = ρ_f ν the dynamic viscosity).
+pub(crate) fn wen_yu_u_mf(f: &Fluid, rho_p: f64, d: f64, g: f64) -> f64 {
+    let mu = f.density * f.viscosity;
+    let ar = f.density * (rho_p - f.density) * g * d.powi(3) / (mu * mu);
+    let re = (33.7f64.powi(2) + 0.0408 * ar).sqrt() - 33.7;
+    re * mu / (f.density * d)
+}
+
+/// The velocity at which Ergun's (1952) pressure gradient through a bed of porosity ε carries the bed's
+/// weight less buoyancy, (1 − ε)(ρ_p − ρ_f) g \[m/s\] (the positive root of the quadratic).
+pub(crate) fn ergun_u_mf(f: &Fluid, eps: f64, rho_p: f64, d: f64, g: f64) -> f64 {
+    let w = (1.0 - eps) * (rho_p - f.density) * g;
+    // ergun(ε, U) = a U + b U².
+    let a = ergun(eps, 1.0, d, f)
+        - ergun(eps, 0.0, d, f)
+        - (ergun(eps, 2.0, d, f) - 2.0 * ergun(eps, 1.0, d, f)) / 2.0;
+    let b = (ergun(eps, 2.0, d, f) - 2.0 * ergun(eps, 1.0, d, f)) / 2.0;
+    (-a + (a * a + 4.0 * b * w).sqrt()) / (2.0 * b)
+}
+
+/// The result of a fluidisation sweep.
+#[derive(Clone, Debug)]
+pub(crate) struct Fluidisation {
+    /// Per level: superficial velocity \[m/s\], mean pressure drop across the column \[Pa\], bed
+    /// porosity from the bed height (1 − V_s/(A H)), and Ergun's pressure drop summed over the cells
+    /// with each cell's void fraction (area-averaged over the columns of cells) \[Pa\].
+    pub points: Vec<(f64, f64, f64, f64)>,
+    /// The beads' weight less buoyancy per unit cross-section \[Pa\].
+    pub weight_per_area: f64,
+    /// U_mf where the fixed-bed branch a U + b U² (fitted to the fixed levels) reaches the plateau
+    /// (the mean pressure drop of the fluidised levels) \[m/s\].
+    pub u_mf_knee: f64,
+    /// The plateau \[Pa\].
+    pub plateau: f64,
+    /// Mean porosity of the fixed levels.
+    pub eps_fixed: f64,
+    /// Wen & Yu's U_mf \[m/s\].
+    pub u_mf_wen_yu: f64,
+}
+
+/// 1 mm glass beads (ρ_p = 2500 kg/m³, frictionless, softened to E = 1 MPa: the bed's weight compresses
+/// its contacts by under 1 % of the radius) settled in water in a square column of `side` × `side`
+/// cells of 3 mm (3 d) and 14 cells tall, slip sides for the water, planes for the beads. Water then
+/// enters at the bottom at the superficial velocities `levels` × U_mf(Wen–Yu) in increasing order, each
+/// held for `hold_s` and the pressure drop bottom-to-top averaged over the last 40 % of it. DEM step
+/// 2·10⁻⁵ s (15 % of the Rayleigh time), 5 DEM steps per fluid step (Δt_f = 10⁻⁴ s), drag
+/// `ergun_wen_yu`, model A.
+pub(crate) fn fluidisation(
+    side: usize,
+    spheres: usize,
+    levels: &[f64],
+    settle_s: f64,
+    hold_s: f64,
+) -> Result<Fluidisation, String> {
+    let d = 1e-3;
+    let h = 3e-3;
+    let rho_p = 2500.0;
+    let nz = 14;
+    let width = side as f64 * h;
+    let u_wy = wen_yu_u_mf(&water(), rho_p, d, 9.81);
+    let inlet = |u: f64| Boundary::Inlet { velocity_m_s: [0.0, 0.0, u], table: Default::default() };
+    let outlet = Boundary::Outlet { pressure_pa: 0.0 };
+    let f = flow(
+        [side, side, nz],
+        h,
+        [Boundary::Slip, Boundary::Slip, Boundary::Slip, Boundary::Slip, inlet(0.0), outlet],
+    )?;
+    let mats = vec![
+        Material { youngs_modulus: 1e6, poisson_ratio: 0.25, density: rho_p },
+        Material { youngs_modulus: 1e6, poisson_ratio: 0.25, density: rho_p },
+    ];
+    let mut dm = Simulation::new(
+        HertzMindlin::default(),
+        mats.clone(),
+        uniform_pairs(&mats, 0.0, 0.5),
+        2e-5,
+        Settings::default(),
+    );
+    dm.gravity = G;
+    let top = nz as f64 * h;
+    for (x, n) in [
+        (Vec3::ZERO, Vec3::Z),
+        (Vec3::new(0.0, 0.0, top), -Vec3::Z),
+        (Vec3::ZERO, Vec3::X),
+        (Vec3::new(width, 0.0, 0.0), -Vec3::X),
+        (Vec3::ZERO, Vec3::Y),
+        (Vec3::new(0.0, width, 0.0), -Vec3::Y),
+    ] {
+        let shape = spatter_dem::walls::WallShape::Plane(spatter_dem::walls::Plane::new(x, n));
+        dm.add_wall(spatter_dem::walls::Wall {
+            name: format!("wall_{}", dm.walls.len()),
+            shape,
+            material: 1,
+            motion: spatter_core::motion::Motion::Fixed,
+        });
+    }
+    // A cubic lattice of spacing 1.2 d with deterministic jitter (golden-ratio sequence), so that the
+    // settled packing is random.
+    let s = 1.2 * d;
+    let per = ((width - d) / s).floor() as usize;
+    let mut k = 0;
+    while dm.particles.len() < spheres {
+        let (i, j, l) = (k % per, (k / per) % per, k / (per * per));
+        let jit = |m: usize| ((m as f64 * 0.618_033_988_75).fract() - 0.5) * 0.15 * d;
+        let x = Vec3::new(
+            0.5 * d + 0.1 * d + s * i as f64 + jit(3 * k),
+            0.5 * d + 0.1 * d + s * j as f64 + jit(3 * k + 1),
+            0.6 * d + s * l as f64 + jit(3 * k + 2),
+        );
+        if x.z + 0.5 * d > top {
+            return Err(format!("{spheres} spheres do not fit the column"));
+        }
+        dm.add_particle(NewParticle::at(x, 0.5 * d, 0));
+        k += 1;
+    }
+    let opts = CouplingOptions {
+        forces: FluidForceOptions { drag: DragModel::ErgunWenYu, ..Default::default() },
+        dem_steps_per_fluid_step: 5,
+        ..Default::default()
+    };
+    let mut c = Coupled::new(f, dm, opts).map_err(|e| e.to_string())?;
+    let area = width * width;
+    let vs: f64 = c.dem.particles.radius.iter().map(|r| 4.0 / 3.0 * PI * r.powi(3)).sum();
+    let weight_per_area = vs * (rho_p - 1000.0) * 9.81 / area;
+    let dt = c.fluid_dt();
+    let run =
+        |c: &mut Coupled<HertzMindlin>, t: f64, avg_from: f64, u: f64| -> Result<(f64, f64, f64), String> {
+            let steps = (t / dt).round() as u64;
+            let first = (avg_from / dt).round() as u64;
+            let (mut dp, mut hsum, mut n, mut pred) = (0.0, 0.0, 0.0, 0.0);
+            for k in 0..steps {
+                let rep = c.step().map_err(|e| e.to_string())?;
+                if rep.relative_mismatch >= 1e-12 {
+                    return Err(format!("momentum balance off by {:e}", rep.relative_mismatch));
+                }
+                if k >= first {
+                    let l = c.flow.grid.layout;
+                    let layer = |kz: usize| {
+                        let mut s = 0.0;
+                        for j in 0..l.n[1] {
+                            for i in 0..l.n[0] {
+                                s += c.flow.cell_pressure(i, j, kz);
+                            }
+                        }
+                        s / (l.n[0] * l.n[1]) as f64
+                    };
+                    dp += layer(0) - layer(l.n[2] - 1);
+                    // Ergun cell by cell, from the centre of the bottom layer to the centre of the top one.
+                    let mut e = 0.0;
+                    for j in 0..l.n[1] {
+                        for i in 0..l.n[0] {
+                            for kz in 0..l.n[2] {
+                                let w = if kz == 0 || kz == l.n[2] - 1 { 0.5 } else { 1.0 };
+                                let a = c.void_fraction().alpha[l.cell(i, j, kz)];
+                                e += w * h * ergun(a, u, d, &water());
+                            }
+                        }
+                    }
+                    pred += e / (l.n[0] * l.n[1]) as f64;
+                    let z = &c.dem.particles.pos;
+                    hsum += 2.0 * z.iter().map(|x| x.z).sum::<f64>() / z.len() as f64;
+                    n += 1.0;
+                }
+            }
+            Ok((dp / n, hsum / n, pred / n))
+        };
+    run(&mut c, settle_s, 0.0, 0.0)?;
+    let mut points = Vec::new();
+    for &lv in levels {
+        let u = lv * u_wy;
+        c.flow.bc[4] = inlet(u);
+        let (dp, hb, pred) = run(&mut c, hold_s, 0.6 * hold_s, u)?;
+        points.push((u, dp, 1.0 - vs / (area * hb), pred));
+    }
+    // Fixed levels: the bed not lifted (pressure drop below 85 % of its weight per area).
+    let fixed: Vec<_> = points.iter().filter(|p| p.1 < 0.85 * weight_per_area).copied().collect();
+    let fluid: Vec<_> = points.iter().filter(|p| p.1 >= 0.85 * weight_per_area).copied().collect();
+    if fixed.len() < 2 || fluid.is_empty() {
+        return Err(format!("need two fixed and one fluidised level, got {points:?}"));
+    }
+    let plateau = fluid.iter().map(|p| p.1).sum::<f64>() / fluid.len() as f64;
+    // Least squares of Δp/U = a + b U over the fixed levels.
+    let n = fixed.len() as f64;
+    let (sx, sy) = fixed.iter().fold((0.0, 0.0), |(sx, sy), p| (sx + p.0, sy + p.1 / p.0));
+    let (sxx, sxy) = fixed.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0 * p.0, b + p.0 * p.1 / p.0));
+    let b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    let a = (sy - b * sx) / n;
+    let u_mf_knee = if b.abs() < 1e-12 * a.abs() {
+        plateau / a
+    } else {
+        (-a + (a * a + 4.0 * b * plateau).sqrt()) / (2.0 * b)
+    };
+    let eps_fixed = fixed.iter().map(|p| p.2).sum::<f64>() / n;
+    Ok(Fluidisation { points, weight_per_area, u_mf_knee, plateau, eps_fixed, u_mf_wen_yu: u_wy })
+}
+
+fn fluidisation_case(quick: bool) -> Vec<Check> {
+    let c = "cfd_dem_minimum_fluidisation";
+    let src = "Wen & Yu (1966) Re_mf = sqrt(33.7^2 + 0.0408 Ar) - 33.7, 1 mm glass beads in water";
+    let r = if quick {
+        fluidisation(2, 300, &[0.3, 0.6, 2.0], 0.25, 0.1)
+    } else {
+        fluidisation(3, 1200, &[0.2, 0.4, 0.6, 0.8, 1.5, 2.0, 2.5], 0.3, 0.15)
+    };
+    let Ok(r) = r else {
+        return vec![Check::relative(c, "U_mf [m/s]", 0.0079, f64::NAN, 0.25, src)];
+    };
+    for p in &r.points {
+        tracing::info!(
+            "U = {:.5} m/s: pressure drop {:.3} Pa (Ergun over the void-fraction field {:.3} Pa), bed porosity {:.4}",
+            p.0,
+            p.1,
+            p.3,
+            p.2
+        );
+    }
+    let ergun_mf = ergun_u_mf(&water(), r.eps_fixed, 2500.0, 1e-3, 9.81);
+    vec![
+        Check::relative(
+            c,
+            "fluidised pressure drop = weight less buoyancy per area [Pa]",
+            r.weight_per_area,
+            r.plateau,
+            0.05,
+            "bed weight (rho_p - rho_f) g V_s / A",
+        ),
+        Check::relative(
+            c,
+            format!("U_mf from the knee against Ergun at the bed's eps = {:.3} [m/s]", r.eps_fixed),
+            ergun_mf,
+            r.u_mf_knee,
+            0.1,
+            "Ergun (1952) balanced against the bed weight",
+        ),
+        Check::relative(c, "U_mf from the knee [m/s]", r.u_mf_wen_yu, r.u_mf_knee, 0.25, src),
+    ]
 }

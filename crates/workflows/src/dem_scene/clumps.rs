@@ -11,7 +11,7 @@ use spatter_dem::clump::{ClumpTemplate, MassBasis};
 use spatter_dem::error::DemError;
 use spatter_dem::wear::WearModel;
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A clump template: a shape and how it is made of spheres.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -296,9 +296,9 @@ impl TemplateConfig {
         }
     }
 
-    /// Builds the template `name`; `resolve` makes file paths absolute. Errors name the key
-    /// `templates.<name>.…` and, for files, the file and line.
-    pub fn build(&self, name: &str, resolve: impl Fn(&Path) -> PathBuf) -> Result<ClumpTemplate, DemError> {
+    /// Builds the template `name`. Errors name the key `templates.<name>.…` and, for files, the file and
+    /// line.
+    pub fn build(&self, name: &str) -> Result<ClumpTemplate, DemError> {
         let key = |k: &str| format!("templates.{name}.{k}");
         let from = |k: &str| {
             let key = key(k);
@@ -318,14 +318,11 @@ impl TemplateConfig {
             }
         };
         let (spheres, envelope) = match &self.shape {
-            TemplateShape::Spheres { file } => {
-                (read_sphere_file(&resolve(file)).map_err(from("shape.file"))?, None)
-            }
+            TemplateShape::Spheres { file } => (read_sphere_file(file).map_err(from("shape.file"))?, None),
             TemplateShape::Mesh { file, scale } => {
-                let path = resolve(file);
-                let mesh = TriMesh::load(&path, *scale)
+                let mesh = TriMesh::load(file, *scale)
                     .map_err(|e| DemError::Config { key: key("shape.file"), message: e.to_string() })?;
-                check_closed(&mesh, &path).map_err(from("shape.file"))?;
+                check_closed(&mesh, file).map_err(from("shape.file"))?;
                 let solid = MeshSolid::new(mesh);
                 (packed(&solid)?, Some(solid.volume()))
             }

@@ -13,7 +13,7 @@ use spatter_dem::contact::RestitutionCalibration;
 use spatter_dem::insertion::Lattice;
 use spatter_dem::sim::Integrator;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A DEM scene: materials, pairs, walls, particles, time stepping and outputs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,10 +60,6 @@ pub struct SceneConfig {
     pub wear: Vec<WearConfig>,
     #[serde(default)]
     pub output: OutputConfig,
-    /// Folder that relative file paths (meshes, motion tables) are resolved against; set by the loader
-    /// to the scenario file's folder (the working directory when unset).
-    #[serde(skip)]
-    pub base_dir: Option<PathBuf>,
 }
 
 fn default_output_interval() -> f64 {
@@ -570,14 +566,6 @@ impl Default for OutputConfig {
 }
 
 impl SceneConfig {
-    /// Resolves a path from the file against [`SceneConfig::base_dir`].
-    pub fn resolve(&self, p: &Path) -> PathBuf {
-        match &self.base_dir {
-            Some(b) if p.is_relative() => b.join(p),
-            _ => p.to_owned(),
-        }
-    }
-
     /// Material names in index order (the order of the `materials` table).
     pub fn material_names(&self) -> Vec<&str> {
         self.materials.keys().map(String::as_str).collect()

@@ -332,49 +332,20 @@ pub fn trajectory_rows<L: ContactLaw>(sim: &Simulation<L>, cfg: &TrajectoryConfi
     let p = &sim.particles;
     let mut rows = Vec::new();
     for k in (0..b.len()).filter(|&k| cfg.follows(b.id[k])) {
-        let (x, v, q, w) = (b.pos[k], b.vel[k], b.quat[k], b.omega[k]);
-        rows.push(vec![
-            t,
-            1.0,
-            b.id[k] as f64,
-            x.x,
-            x.y,
-            x.z,
-            v.x,
-            v.y,
-            v.z,
-            q.w,
-            q.x,
-            q.y,
-            q.z,
-            w.x,
-            w.y,
-            w.z,
-        ]);
+        let q = b.quat[k];
+        rows.push(trajectory_row(t, true, b.id[k], b.pos[k], b.vel[k], [q.w, q.x, q.y, q.z], b.omega[k]));
     }
     let mut spheres: Vec<usize> =
         (0..p.len()).filter(|&i| p.body[i] == NO_BODY && cfg.follows(p.id[i])).collect();
     spheres.sort_by_key(|&i| p.id[i]);
     for i in spheres {
-        let (x, v, w) = (p.pos[i], p.vel[i], p.omega[i]);
-        rows.push(vec![
-            t,
-            0.0,
-            p.id[i] as f64,
-            x.x,
-            x.y,
-            x.z,
-            v.x,
-            v.y,
-            v.z,
-            1.0,
-            0.0,
-            0.0,
-            0.0,
-            w.x,
-            w.y,
-            w.z,
-        ]);
+        rows.push(trajectory_row(t, false, p.id[i], p.pos[i], p.vel[i], [1.0, 0.0, 0.0, 0.0], p.omega[i]));
     }
     rows
+}
+
+/// One row of `trajectories.csv` in the order of [`TRAJECTORY_COLUMNS`]; `q` is (w, x, y, z).
+fn trajectory_row(t: f64, body: bool, id: u32, x: Vec3, v: Vec3, q: [f64; 4], w: Vec3) -> Vec<f64> {
+    let kind = if body { 1.0 } else { 0.0 };
+    vec![t, kind, id as f64, x.x, x.y, x.z, v.x, v.y, v.z, q[0], q[1], q[2], q[3], w.x, w.y, w.z]
 }

@@ -8,7 +8,8 @@ mod run;
 pub mod setup;
 
 pub use config::*;
-pub use run::{run, run_collect, MeshWallResult, SceneResults};
+pub(crate) use run::{inject, time_step_warnings};
+pub use run::{run, run_collect, simulation, with_law, MeshWallResult, SceneResults, WithLaw};
 
 #[cfg(test)]
 mod tests;

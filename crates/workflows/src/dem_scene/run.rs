@@ -21,7 +21,7 @@ use spatter_dem::sim::{SimState, Simulation};
 use spatter_dem::timestep;
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 
 /// Everything a resumed run needs (the checkpoint header names the input it belongs to: a resume with
 /// another scene is refused when it is loaded).
@@ -102,7 +102,35 @@ pub fn run_collect(
     cfg: &SceneConfig,
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
-    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
+    Checker::run(cfg, None).map_err(DemError::Invalid)?;
+    with_law(cfg, SceneRun { cfg, ctx })
+}
+
+/// The scene's own run, as a [`WithLaw`] visitor.
+struct SceneRun<'a> {
+    cfg: &'a SceneConfig,
+    ctx: &'a RunContext<'a>,
+}
+
+impl WithLaw for SceneRun<'_> {
+    type Output = (RunSummary, Option<SceneResults>);
+    fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError> {
+        run_with(law, built, self.cfg, self.ctx)
+    }
+}
+
+/// Something run with the contact law a scene chooses (`[contact]` and the pairs decide the law's type,
+/// so the engine is monomorphised for it): the scene's own run, or a workflow that drives the DEM itself
+/// (the `cfd_dem` kind).
+pub trait WithLaw {
+    type Output;
+    /// Called once with the scene's law and its built materials, pairs, walls and templates.
+    fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError>;
+}
+
+/// Builds the scene's engine objects and calls `v` with the contact law `[contact]` chooses (one
+/// monomorphised engine per combination). The scene must have been validated.
+pub fn with_law<V: WithLaw>(cfg: &SceneConfig, v: V) -> Result<V::Output, DemError> {
     let c = &cfg.contact;
     let damping = RestitutionDamping {
         tensile_clamp: c.tensile_clamp,
@@ -132,32 +160,20 @@ pub fn run_collect(
         let ac = c.adhesive_coulomb;
         return match (c.normal, c.tangential) {
             (NormalKind::Hertz, TangentialKind::Linear) => {
-                run_with(configured(Composed::new(Hertz, d, linear, r), cfg), built, cfg, ctx)
+                v.with(configured(Composed::new(Hertz, d, linear, r), cfg), built)
             }
-            (NormalKind::Hertz, _) => {
-                run_with(configured(Composed::new(Hertz, d, variant, r), cfg), built, cfg, ctx)
-            }
+            (NormalKind::Hertz, _) => v.with(configured(Composed::new(Hertz, d, variant, r), cfg), built),
             (NormalKind::Hooke, TangentialKind::Linear) => {
-                run_with(configured(Composed::new(hooke, d, linear, r), cfg), built, cfg, ctx)
+                v.with(configured(Composed::new(hooke, d, linear, r), cfg), built)
             }
-            (NormalKind::Hooke, _) => {
-                run_with(configured(Composed::new(hooke, d, variant, r), cfg), built, cfg, ctx)
+            (NormalKind::Hooke, _) => v.with(configured(Composed::new(hooke, d, variant, r), cfg), built),
+            (NormalKind::Jkr, _) => v.with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built),
+            (NormalKind::Dmt, _) => {
+                v.with(configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg), built)
             }
-            (NormalKind::Jkr, _) => {
-                run_with(configured(Composed::new(jkr, d, Mindlin, r), cfg), built, cfg, ctx)
+            (NormalKind::Sjkr, _) => {
+                v.with(configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg), built)
             }
-            (NormalKind::Dmt, _) => run_with(
-                configured(Composed::new(DmtLaw { coulomb: ac }, d, Mindlin, r), cfg),
-                built,
-                cfg,
-                ctx,
-            ),
-            (NormalKind::Sjkr, _) => run_with(
-                configured(Composed::new(SjkrLaw { coulomb: ac }, d, Mindlin, r), cfg),
-                built,
-                cfg,
-                ctx,
-            ),
         };
     }
     // One monomorphised engine per combination.
@@ -165,47 +181,41 @@ pub fn run_collect(
     match (c.normal, c.tangential) {
         // Linear cohesion (Hooke with an attractive cohesion spring) only where some pair has it.
         (NormalKind::Hooke, TangentialKind::Linear) if cfg.has_cohesion() => {
-            run_with(configured(Composed::new(cohesive, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(cohesive, damping, linear, r), cfg), built)
         }
         (NormalKind::Hooke, k) if cfg.has_cohesion() => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(cohesive, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(cohesive, damping, t, r), cfg), built)
         }
         (NormalKind::Hertz, TangentialKind::Mindlin) => {
-            run_with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, Mindlin, r), cfg), built)
         }
         (NormalKind::Hertz, TangentialKind::Linear) => {
-            run_with(configured(Composed::new(Hertz, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, linear, r), cfg), built)
         }
         (NormalKind::Hooke, TangentialKind::Mindlin) => {
-            run_with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, Mindlin, r), cfg), built)
         }
         (NormalKind::Hooke, TangentialKind::Linear) => {
-            run_with(configured(Composed::new(hooke, damping, linear, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, linear, r), cfg), built)
         }
         // The other Mindlin history rules share one engine per normal law (the rule is a runtime field).
         (NormalKind::Hertz, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(Hertz, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(Hertz, damping, t, r), cfg), built)
         }
         (NormalKind::Hooke, k) => {
             let t = MindlinVariant { history: k.mindlin_history().unwrap_or_default() };
-            run_with(configured(Composed::new(hooke, damping, t, r), cfg), built, cfg, ctx)
+            v.with(configured(Composed::new(hooke, damping, t, r), cfg), built)
         }
-        (NormalKind::Jkr, _) => {
-            run_with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built, cfg, ctx)
-        }
-        (NormalKind::Dmt, _) => run_with(
+        (NormalKind::Jkr, _) => v.with(configured(Composed::new(jkr, damping, Mindlin, r), cfg), built),
+        (NormalKind::Dmt, _) => v.with(
             configured(Composed::new(DmtLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
-            cfg,
-            ctx,
         ),
-        (NormalKind::Sjkr, _) => run_with(
+        (NormalKind::Sjkr, _) => v.with(
             configured(Composed::new(SjkrLaw { coulomb: c.adhesive_coulomb }, damping, Mindlin, r), cfg),
             built,
-            cfg,
-            ctx,
         ),
     }
 }
@@ -315,12 +325,9 @@ fn configured<N, D, T, R>(mut law: Composed<N, D, T, R>, cfg: &SceneConfig) -> C
     law
 }
 
-fn run_with<L: ContactLaw>(
-    law: L,
-    built: setup::Built,
-    cfg: &SceneConfig,
-    ctx: &RunContext,
-) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+/// The scene's simulation with its law, engine settings, gravity, walls, templates and wear models, and
+/// no particles yet (the fills are [`setup::initial_particles`]).
+pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig) -> Simulation<L> {
     let e = &cfg.engine;
     let settings = spatter_dem::sim::Settings {
         integrator: e.integrator,
@@ -346,6 +353,16 @@ fn run_with<L: ContactLaw>(
         sim.add_template(t);
     }
     sim.set_wear(built.wear);
+    sim
+}
+
+fn run_with<L: ContactLaw>(
+    law: L,
+    built: setup::Built,
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    let mut sim = simulation(law, built, cfg);
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
     let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
@@ -526,8 +543,10 @@ fn run_with<L: ContactLaw>(
     if cfg.output.trajectories.is_some() {
         s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
     }
-    for (name, png) in write_wear_maps(&sim, ctx)? {
+    for (name, png, record) in write_wear_maps(&sim, ctx)? {
         s.artifacts.push((format!("eroded mass map {name}"), png));
+        s.artifacts.push((format!("eroded mass per triangle {name} (VTU)"), record.vtu.clone()));
+        s.maps.push(record);
     }
     let r = results(&sim, events);
     Ok((s, Some(r)))
@@ -555,11 +574,14 @@ fn write_events<L: ContactLaw>(
 
 /// For every mesh wall that a wear model applies to, `wear/<name>_eroded_mass.png`: the eroded mass per
 /// triangle at the end of the run, seen against the wall's area-weighted mean normal (the side the
-/// particles hit), with the global z axis (or y for a horizontal wall) towards the top.
+/// particles hit), with the global z axis (or y for a horizontal wall) towards the top; and
+/// `wear/<name>_eroded_mass.vtu`, the wall in its final pose with the cell array `eroded_mass_kg` the picture
+/// shows. Returns (wall name, picture, map record); the record lets a study redraw the map of every case on
+/// one colour scale.
 fn write_wear_maps<L: ContactLaw>(
     sim: &Simulation<L>,
     ctx: &RunContext,
-) -> Result<Vec<(String, std::path::PathBuf)>, DemError> {
+) -> Result<Vec<(String, std::path::PathBuf, MeshMapRecord)>, DemError> {
     let mut out = Vec::new();
     let mats = sim.materials().len();
     for wall in &sim.walls {
@@ -574,25 +596,33 @@ fn write_wear_maps<L: ContactLaw>(
         let view = -n.normalize_or_zero();
         let up = if view.cross(Vec3::Z).length() > 1e-3 { Vec3::Z } else { Vec3::Y };
         let name = &wall.name;
+        let vtu = ctx.dir.path(&format!("wear/{name}_eroded_mass.vtu"));
+        spatter_io::vtu::Vtu::triangles(&mesh.vertices, &mesh.triangles)
+            .cell_scalar("eroded_mass_kg", &m.records.eroded_mass)
+            .write(&vtu)
+            .map_err(|source| DemError::Io { path: vtu.clone(), source })?;
         let png = ctx.dir.path(&format!("wear/{name}_eroded_mass.png"));
-        spatter_io::plot::mesh_map_png(
-            &png,
-            &mesh,
-            &m.records.eroded_mass,
-            view,
-            up,
-            &format!("{name}: eroded mass per triangle ({})", sim.wear().names().join(", ")),
-            "eroded mass [kg]",
-        )
-        .map_err(|source| DemError::Io { path: png.clone(), source })?;
-        out.push((name.clone(), png));
+        let title = format!("{name}: eroded mass per triangle ({})", sim.wear().names().join(", "));
+        let colorbar = "eroded mass [kg]";
+        spatter_io::plot::mesh_map_png(&png, &mesh, &m.records.eroded_mass, view, up, &title, colorbar)
+            .map_err(|source| DemError::Io { path: png.clone(), source })?;
+        let record = MeshMapRecord {
+            label: format!("{name} eroded mass"),
+            vtu,
+            array: "eroded_mass_kg".into(),
+            view_dir: view.to_array(),
+            up: up.to_array(),
+            title,
+            colorbar_label: colorbar.into(),
+        };
+        out.push((name.clone(), png, record));
     }
     Ok(out)
 }
 
 /// Places the particles injector `k` owes at the current time, clear of the particles present and of the
 /// walls where they are now.
-fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
+pub(crate) fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
     let t = sim.time();
     if t < inj.start || (inj.due(t) == 0 && inj.state.pending.is_some()) {
         return;
@@ -641,7 +671,7 @@ fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &R
 }
 
 /// Time-step warnings for the particles present and to be injected.
-fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<String> {
+pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<String> {
     let mut sizes: Vec<(usize, f64)> = Vec::new();
     let p = &sim.particles;
     for i in 0..p.len() {
@@ -669,7 +699,7 @@ fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> 
             b = b.grown_to(*x);
         }
         for j in &cfg.inject {
-            if let Ok(r) = setup::region(cfg, &j.region) {
+            if let Ok(r) = setup::region(&j.region) {
                 b = b.union(r.bounds());
             }
         }

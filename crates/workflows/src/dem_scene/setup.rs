@@ -64,10 +64,6 @@ fn material_index(cfg: &SceneConfig, name: &str, key: &str) -> Result<u16, DemEr
     })
 }
 
-fn load_mesh(cfg: &SceneConfig, file: &std::path::Path, scale: f64) -> Result<TriMesh, DemError> {
-    Ok(TriMesh::load(&cfg.resolve(file), scale)?)
-}
-
 /// Materials, pair table and walls.
 pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
     let materials: Vec<Material> = cfg.materials.values().cloned().collect();
@@ -149,7 +145,7 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
                 })
             }
             ShapeConfig::Mesh { file, scale } => {
-                WallShape::Mesh(Box::new(MeshWall::new(load_mesh(cfg, file, *scale)?)))
+                WallShape::Mesh(Box::new(MeshWall::new(TriMesh::load(file, *scale)?)))
             }
         };
         let motion = match &w.motion {
@@ -159,12 +155,11 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
                 Motion::rotation(*center_m, *axis, *angular_speed_rad_s)
             }
             MotionConfig::Tabulated { file, reference_point_m } => {
-                let path = cfg.resolve(file);
-                let text = std::fs::read_to_string(&path)
-                    .map_err(|source| DemError::Io { path: path.clone(), source })?;
+                let text = std::fs::read_to_string(file)
+                    .map_err(|source| DemError::Io { path: file.clone(), source })?;
                 let table = MotionTable::parse(&text, *reference_point_m).map_err(|e| DemError::Config {
                     key: format!("walls[{i}].motion.file"),
-                    message: format!("{}: {e}", path.display()),
+                    message: format!("{}: {e}", file.display()),
                 })?;
                 Motion::Tabulated(table)
             }
@@ -173,7 +168,7 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
     }
     let mut templates = Vec::with_capacity(cfg.templates.len());
     for (name, t) in &cfg.templates {
-        templates.push(t.build(name, |p| cfg.resolve(p))?);
+        templates.push(t.build(name)?);
     }
     let mut wear = WearTable::new(n);
     for (i, w) in cfg.wear.iter().enumerate() {
@@ -207,13 +202,13 @@ pub fn clump_mix(
 }
 
 /// The engine region of a region configuration.
-pub fn region(cfg: &SceneConfig, r: &RegionConfig) -> Result<Region, DemError> {
+pub fn region(r: &RegionConfig) -> Result<Region, DemError> {
     Ok(match r {
         RegionConfig::Box { min_m, max_m } => Region::Box(Aabb::new(*min_m, *max_m)),
         RegionConfig::Cylinder { base_m, axis, radius_m, height_m } => {
             Region::Cylinder { base: *base_m, axis: axis.normalize(), radius: *radius_m, height: *height_m }
         }
-        RegionConfig::Mesh { file, scale } => Region::mesh(load_mesh(cfg, file, *scale)?),
+        RegionConfig::Mesh { file, scale } => Region::mesh(TriMesh::load(file, *scale)?),
     })
 }
 
@@ -247,7 +242,7 @@ pub fn initial_particles(
     let mut out = Initial::default();
     for (i, f) in cfg.fill.iter().enumerate() {
         let material = material_index(cfg, &f.material, &format!("fill[{i}].material"))?;
-        let reg = region(cfg, &f.region)?;
+        let reg = region(&f.region)?;
         let mut rng: Rng = seeded(cfg.seed, 1000 + i as u64);
         if let Some(mix) = &f.clumps {
             let density = cfg.materials[&f.material].density;
@@ -427,7 +422,7 @@ pub fn injectors(
             attempts: j.attempts,
             state: InjectorState::new(seeded(cfg.seed, 2000 + i as u64)),
         };
-        out.push((inj, region(cfg, &j.region)?));
+        out.push((inj, region(&j.region)?));
     }
     Ok(out)
 }

@@ -673,6 +673,11 @@ fn a_stone_scene_runs_resumes_bit_for_bit_and_reports_its_wear() {
     let per_triangle: f64 = mesh.cell_array("eroded_mass_kg").unwrap().values.iter().sum();
     assert!((per_triangle - total).abs() <= 1e-12 * total, "{per_triangle} vs {total}");
     assert!(full.root().join("wear/floor_eroded_mass.png").is_file());
+    // The map is recorded for a study's gallery: its VTU holds the same per-triangle values.
+    let map = s.maps.iter().find(|m| m.label == "floor eroded mass").expect("wear map recorded");
+    let recorded = spatter_io::vtk::read(&map.vtu).unwrap();
+    let values = &recorded.cell_array(&map.array).unwrap().values;
+    assert_eq!(values, &mesh.cell_array("eroded_mass_kg").unwrap().values);
     assert!(full.root().join("templates/pebble.vtu").is_file());
 }
 

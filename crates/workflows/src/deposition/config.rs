@@ -35,9 +35,6 @@ pub struct DepositionConfig {
     pub domain: Option<DomainBox>,
     #[serde(default)]
     pub output: OutputSpec,
-    /// Folder relative paths are resolved against (the scenario file's folder; set by the loader).
-    #[serde(skip)]
-    pub base_dir: Option<PathBuf>,
 }
 
 /// The flow field: exactly one of `vtk`, `series`, `files` or `analytic`.
@@ -178,16 +175,6 @@ pub enum PictureQuantity {
     MassPerArea,
     Impacts,
     MeanNormalSpeed,
-}
-
-impl DepositionConfig {
-    /// `p` resolved against the scenario folder.
-    pub fn resolve(&self, p: &Path) -> PathBuf {
-        match &self.base_dir {
-            Some(b) if p.is_relative() => b.join(p),
-            _ => p.to_owned(),
-        }
-    }
 }
 
 impl Validate for FlowSpec {

@@ -83,11 +83,11 @@ pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
         return Ok(Field::Analytic(AnalyticSet { parts: f.analytic.clone(), turbulence: f.turbulence }));
     }
     let files: Vec<(f64, PathBuf)> = if let Some(v) = &f.vtk {
-        vec![(0.0, cfg.resolve(v))]
+        vec![(0.0, v.clone())]
     } else if let Some(s) = &f.series {
-        spatter_io::vtk::series::read_series(&cfg.resolve(s)).map_err(FieldError::from)?
+        spatter_io::vtk::series::read_series(s).map_err(FieldError::from)?
     } else {
-        f.files.iter().map(|t| (t.time_s, cfg.resolve(&t.file))).collect()
+        f.files.iter().map(|t| (t.time_s, t.file.clone())).collect()
     };
     let opts = ImportOptions {
         interpolation: f.interpolation,
@@ -103,13 +103,13 @@ pub fn build_field(cfg: &DepositionConfig) -> Result<Field, DepositionError> {
 pub fn build_bodies(cfg: &DepositionConfig, field: &Field) -> Result<Vec<Body>, DepositionError> {
     let mut out = Vec::new();
     for b in &cfg.bodies {
-        let mut mesh = TriMesh::load(&cfg.resolve(&b.file), b.scale)
+        let mut mesh = TriMesh::load(&b.file, b.scale)
             .map_err(|e| DepositionError::Body { name: b.name.clone(), message: e.to_string() })?;
         if b.translate_m != Vec3::ZERO {
             let t = b.translate_m;
             mesh.map_vertices(|v| v + t);
         }
-        let rule = WallRule::from_spec(&b.wall, cfg.base_dir.as_deref())?;
+        let rule = WallRule::from_spec(&b.wall)?;
         let mut body = Body::new(b.name.clone(), mesh, rule);
         let lift_needs_shear = cfg.forces.wall_lift.is_some_and(|w| w.friction_velocity.is_none());
         if lift_needs_shear || matches!(b.wall, WallRuleSpec::RegimeMap { max_wall_shear_pa: Some(_), .. }) {
@@ -162,7 +162,7 @@ fn write_parcels(tr: &Tracker<Field>, ctx: &RunContext, k: u64, pvd: &mut PvdSer
 pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, DepositionError> {
     // Scenario files are validated by the loader; a configuration built in Rust is checked here (a zero
     // dt_s would otherwise mean u64::MAX steps).
-    Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DepositionError::Invalid)?;
+    Checker::run(cfg, None).map_err(DepositionError::Invalid)?;
     let field = build_field(cfg)?;
     let bodies = build_bodies(cfg, &field)?;
     let settings = TrackSettings {
@@ -180,12 +180,11 @@ pub fn run(cfg: &DepositionConfig, ctx: &RunContext) -> Result<RunSummary, Depos
     }
     let model = ForceModel::new(cfg.fluid, cfg.forces.clone());
     let mut tr = Tracker::new(field, model, settings, bodies);
-    let base = cfg.base_dir.as_deref();
     let mut injectors: Vec<Injector> = cfg
         .injectors
         .iter()
         .enumerate()
-        .map(|(i, s)| Injector::new(s.clone(), i as u64, base))
+        .map(|(i, s)| Injector::new(s.clone(), i as u64))
         .collect::<Result<_, _>>()?;
     let csv_path = ctx.dir.path("balance.csv");
     let pvd_path = ctx.dir.path("parcels.pvd");

@@ -44,11 +44,11 @@ fn scenario(dir: &Path) -> DepositionConfig {
         dispersion: Some(Default::default()),
         bodies: vec![BodySpec {
             name: "plate".into(),
-            file: "plate.stl".into(),
+            file: dir.join("plate.stl"),
             scale: 1.0,
             translate_m: Vec3::ZERO,
             wall: WallRuleSpec::RegimeMap {
-                file: "map.json".into(),
+                file: dir.join("map.json"),
                 bounce: Restitution { normal: 0.4, tangential: 0.9 },
                 max_tangential_speed_m_s: None,
                 max_wall_shear_pa: None,
@@ -80,7 +80,6 @@ fn scenario(dir: &Path) -> DepositionConfig {
             parcels: true,
             picture_quantity: PictureQuantity::MassPerArea,
         },
-        base_dir: Some(dir.to_owned()),
     }
 }
 

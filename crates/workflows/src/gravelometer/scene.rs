@@ -105,7 +105,7 @@ fn stones(cfg: &GravelometerConfig) -> Result<Vec<Stone>, GravelometerError> {
     };
     let mut out = Vec::new();
     for ((name, config), ratio) in configs.into_iter().zip(ratios) {
-        let template = config.build(&name, |p| p.to_owned()).map_err(|e| match e {
+        let template = config.build(&name).map_err(|e| match e {
             spatter_dem::error::DemError::Config { key, message } => {
                 config_error(&format!("stones.{key}"), message)
             }
@@ -311,7 +311,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
     let mesh = |name: &str, material: &str| WallConfig {
         name: name.to_string(),
         material: material.to_string(),
-        shape: ShapeConfig::Mesh { file: format!("{name}.stl").into(), scale: 1.0 },
+        shape: ShapeConfig::Mesh { file: geometry.join(format!("{name}.stl")), scale: 1.0 },
         motion: Default::default(),
     };
     let templates: BTreeMap<String, TemplateConfig> =
@@ -392,6 +392,5 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
                 first: 1,
             }),
         },
-        base_dir: Some(geometry.to_owned()),
     }
 }

@@ -8,7 +8,6 @@ use spatter_sph::error::SphError;
 use spatter_sph::kernel::Dim;
 use spatter_sph::params::{DragParams, SphParams};
 use spatter_sph::sim::{Simulation, WallOptions};
-use std::path::Path;
 
 /// Numbers fixed while building, reported in the log.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -25,16 +24,8 @@ pub struct BuildInfo {
     pub warnings: Vec<String>,
 }
 
-fn resolve(base: &Path, p: &Path) -> std::path::PathBuf {
-    if p.is_relative() {
-        base.join(p)
-    } else {
-        p.to_owned()
-    }
-}
-
-/// Builds the simulation; relative file names are resolved against `base` (the scenario's folder).
-pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), SphError> {
+/// Builds the simulation (file paths as given: the scenario loader has made them absolute).
+pub fn build(cfg: &SphConfig) -> Result<(Simulation, BuildInfo), SphError> {
     let f = &cfg.fluid;
     let dim = if f.dimensions == 2 { Dim::Two } else { Dim::Three };
     let dp = f.spacing_m;
@@ -86,8 +77,8 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
                     .file
                     .as_deref()
                     .ok_or_else(|| SphError::Setup(format!("motions[{i}].file is missing")))?;
-                let path = resolve(base, file);
-                let text = std::fs::read_to_string(&path).map_err(|e| {
+                let path = file;
+                let text = std::fs::read_to_string(path).map_err(|e| {
                     SphError::Setup(format!("motions[{i}].file = \"{}\": {e}", path.display()))
                 })?;
                 let table =
@@ -133,7 +124,7 @@ pub fn build(cfg: &SphConfig, base: &Path) -> Result<(Simulation, BuildInfo), Sp
                     .file
                     .as_deref()
                     .ok_or_else(|| SphError::Setup(format!("{} is missing", key("file"))))?;
-                let mesh = TriMesh::load(&resolve(base, file), w.scale)?;
+                let mesh = TriMesh::load(file, w.scale)?;
                 sim.add_mesh(&w.name, mesh, w.layers, node, opts)?;
             }
             WallType::Cylinder => {

@@ -7,4 +7,4 @@ mod run;
 
 pub use build::{build, BuildInfo};
 pub use config::SphConfig;
-pub use run::{run, run_in};
+pub use run::run;

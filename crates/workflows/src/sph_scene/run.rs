@@ -7,7 +7,7 @@ use spatter_core::control::Finished;
 use spatter_core::Vec3;
 use spatter_io::csv::{write_table, CsvSeries};
 use spatter_io::pvd::PvdSeries;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use spatter_sph::error::SphError;
 use spatter_sph::sim::Simulation;
@@ -146,14 +146,9 @@ fn io_at(path: &Path) -> impl Fn(std::io::Error) -> SphError + '_ {
     move |e| SphError::Io(std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }
 
-/// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). Relative paths in the
-/// configuration are resolved against the current directory.
+/// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). File paths are taken as given
+/// (the scenario loader has made them absolute; see [`spatter_io::paths`]).
 pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
-    run_in(cfg, ctx, Path::new("."))
-}
-
-/// Like [`run`], resolving relative paths against `base`.
-pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSummary, SphError> {
     let dir = ctx.dir;
     let root = dir.root().to_owned();
     let ckpt = dir.checkpoint_path();
@@ -171,7 +166,7 @@ pub fn run_in(cfg: &SphConfig, ctx: &RunContext, base: &Path) -> Result<RunSumma
         tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
         (st, series, pvd)
     } else {
-        let (sim, info) = build(cfg, base)?;
+        let (sim, info) = build(cfg)?;
         tracing::info!(
             "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s)",
             cfg.title,
@@ -368,16 +363,33 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
             Some(cap) => (0.0, cap),
             None => spatter_io::plot::auto_scale(&fraction),
         };
+        let title = format!("{name}: fraction of time wet (0–{elapsed:.3} s)");
+        let colorbar = "time wet / elapsed";
         spatter_io::plot::mesh_map_png_on_scale(
             &png,
             &squares,
             &fraction,
             (view, up),
-            (&format!("{name}: fraction of time wet (0–{elapsed:.3} s)"), "time wet / elapsed"),
+            (&title, colorbar),
             scale,
         )
         .map_err(io_at(&png))?;
         summary.artifacts.push((format!("wetting map {name}"), png));
+        // The picture's squares and values, so that a study can redraw every case's map on one scale.
+        let squares_vtu = dir.path(&format!("wetting/{name}_squares.vtu"));
+        Vtu::triangles(&squares.vertices, &squares.triangles)
+            .cell_scalar("wet_time_fraction", &fraction)
+            .write(&squares_vtu)
+            .map_err(io_at(&squares_vtu))?;
+        summary.maps.push(MeshMapRecord {
+            label: format!("{name} wetting"),
+            vtu: squares_vtu,
+            array: "wet_time_fraction".into(),
+            view_dir: view.to_array(),
+            up: up.to_array(),
+            title,
+            colorbar_label: colorbar.into(),
+        });
     }
     let wet_csv = dir.path("wetting.csv");
     write_table(

@@ -340,7 +340,7 @@ pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingErr
         plan.t_end,
         plan.x_front0 + plan.speed.distance(plan.t_end)
     );
-    let mut summary = crate::sph_scene::run_in(&scfg, ctx, &geo)?;
+    let mut summary = crate::sph_scene::run(&scfg, ctx)?;
     if summary.finished != Finished::Completed {
         return Ok(summary);
     }
@@ -478,16 +478,7 @@ mod tests {
     use spatter_core::motion::{Motion, MotionTable};
 
     fn wheel(centre: Vec3, r: f64) -> TriMesh {
-        let n = 24;
-        let mut soup = Vec::new();
-        for k in 0..n {
-            let a0 = k as f64 / n as f64 * std::f64::consts::TAU;
-            let a1 = (k + 1) as f64 / n as f64 * std::f64::consts::TAU;
-            let p = |a: f64, y: f64| centre + Vec3::new(r * a.cos(), y, r * a.sin());
-            soup.extend([p(a0, -0.1), p(a1, -0.1), p(a1, 0.1)]);
-            soup.extend([p(a0, -0.1), p(a1, 0.1), p(a0, 0.1)]);
-        }
-        TriMesh::from_triangle_soup(&soup)
+        crate::wading::vehicle::tests::wheel_mesh(centre, r, 0.1, 24)
     }
 
     /// A two-axle vehicle (wheels of radius 0.4 m, wheelbase 3 m) given 2 m above its road position, and

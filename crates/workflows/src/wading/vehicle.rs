@@ -180,19 +180,21 @@ pub fn rolling_speed(v: f64, r: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use spatter_core::mesh::TriMesh;
 
-    fn wheel_mesh(centre: Vec3, r: f64) -> TriMesh {
-        let n = 32;
+    /// The tread of a wheel for the wading tests: a cylinder of radius `r` and width `2 half_width` about
+    /// the axle through `centre` along y, `n` facets round.
+    pub(crate) fn wheel_mesh(centre: Vec3, r: f64, half_width: f64, n: usize) -> TriMesh {
         let mut soup = Vec::new();
         for k in 0..n {
             let a0 = k as f64 / n as f64 * std::f64::consts::TAU;
             let a1 = (k + 1) as f64 / n as f64 * std::f64::consts::TAU;
             let p = |a: f64, y: f64| centre + Vec3::new(r * a.cos(), y, r * a.sin());
-            soup.extend([p(a0, -0.15), p(a1, -0.15), p(a1, 0.15)]);
-            soup.extend([p(a0, -0.15), p(a1, 0.15), p(a0, 0.15)]);
+            let (y0, y1) = (-half_width, half_width);
+            soup.extend([p(a0, y0), p(a1, y0), p(a1, y1)]);
+            soup.extend([p(a0, y0), p(a1, y1), p(a0, y1)]);
         }
         TriMesh::from_triangle_soup(&soup)
     }
@@ -204,23 +206,18 @@ mod tests {
             [("wheel_fl", 4.0, 1.0), ("wheel_fr", 4.0, -1.0), ("wheel_rl", 0.0, 1.0), ("wheel_rr", 0.0, -1.0)]
         {
             let c = Vec3::new(x, y, 0.5);
-            parts.push(NamedPart { name: name.into(), mesh: wheel_mesh(c, 0.5) });
+            parts.push(NamedPart { name: name.into(), mesh: wheel_mesh(c, 0.5, 0.15, 32) });
             wheels.push(WheelSpec { part: name.into(), axle_m: c, radius_m: 0.5, axis: Vec3::Y });
         }
         (parts, wheels)
     }
 
+    /// The shared test channel, lengthened to take the 4 m wheelbase.
     fn channel() -> ChannelSpec {
         ChannelSpec {
             approach_length_m: 8.0,
-            ramp_length_m: 3.0,
             pool_length_m: 10.0,
-            pool_depth_m: 0.5,
-            exit_length_m: 2.0,
-            width_m: 4.0,
-            wall_height_m: 1.0,
-            water_depth_m: 0.3,
-            adhesion: 1.0,
+            ..crate::wading::channel::tests::channel()
         }
     }
 

@@ -1,6 +1,9 @@
-//! Relative file paths in a scenario are relative to the scenario file's folder. After validation the
-//! loader rewrites them to absolute paths, so the run does not depend on the working directory and the
-//! resolved input it writes (`run.toml`) can be run again from anywhere.
+//! The one rule for relative file paths: in a scenario they are relative to the scenario file's folder.
+//! After validation the loader rewrites them to absolute paths with [`absolute_paths`], so the run does not
+//! depend on the working directory and the resolved input it writes (`run.toml`) can be run again from
+//! anywhere. Engines and workflows take the paths of a configuration as they are (a relative path is then
+//! relative to the working directory); a library user who builds a configuration from a file of their own
+//! calls [`absolute_paths`] with that file's folder, as the loader does.
 //!
 //! Convention: a key that names a file is called `file`, `vtk` or `series` (see `docs/scenario.md`).
 //! A test re-checks the `run.toml` of every example from another folder, so a path key outside the
