@@ -54,6 +54,8 @@ pub struct Chart {
     y_range: Option<(f64, f64)>,
     size: (u32, u32),
     series: Vec<Series>,
+    /// Draw the legend in a column right of the plot instead of inside it.
+    legend_right: bool,
 }
 
 /// A short tick label: plain notation for moderate magnitudes, `2.5e-6` style otherwise, with trailing
@@ -108,6 +110,7 @@ impl Chart {
             y_range: None,
             size: (900, 650),
             series: Vec::new(),
+            legend_right: false,
         }
     }
 
@@ -129,6 +132,13 @@ impl Chart {
 
     pub fn y_range(mut self, lo: f64, hi: f64) -> Self {
         self.y_range = Some((lo, hi));
+        self
+    }
+
+    /// Puts the legend in a column right of the plot area (the picture grows by its width), so that
+    /// it never covers a curve; for charts with many series whose curves fill the plot.
+    pub fn legend_right(mut self) -> Self {
+        self.legend_right = true;
         self
     }
 
@@ -202,7 +212,7 @@ impl Chart {
     /// Writes the chart as PNG.
     pub fn save_png(&self, path: &Path) -> io::Result<()> {
         ensure_font();
-        let root = BitMapBackend::new(path, self.size).into_drawing_area();
+        let root = BitMapBackend::new(path, self.picture_size()).into_drawing_area();
         self.draw(&root).map_err(|e| err(path, e))?;
         root.present().map_err(|e| err(path, e))
     }
@@ -210,13 +220,53 @@ impl Chart {
     /// Writes the chart as SVG.
     pub fn save_svg(&self, path: &Path) -> io::Result<()> {
         ensure_font();
-        let root = SVGBackend::new(path, self.size).into_drawing_area();
+        let root = SVGBackend::new(path, self.picture_size()).into_drawing_area();
         self.draw(&root).map_err(|e| err(path, e))?;
         root.present().map_err(|e| err(path, e))
     }
 
+    /// Width of the legend column \[px\] (0 with the legend inside): room for the longest label.
+    fn legend_width(&self) -> u32 {
+        if !self.legend_right {
+            return 0;
+        }
+        let chars = self.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0) as u32;
+        36 + 7 * chars
+    }
+
+    /// The picture size, legend column included.
+    fn picture_size(&self) -> (u32, u32) {
+        (self.size.0 + self.legend_width(), self.size.1)
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
+        if self.legend_right {
+            let (plot, side) = root.split_horizontally(self.size.0);
+            self.draw_legend_column(&side)?;
+            return self.draw_plot(&plot);
+        }
+        self.draw_plot(root)
+    }
+
+    /// The legend as a column of entries (line sample and label), top-aligned with the plot area.
+    fn draw_legend_column<DB: DrawingBackend>(&self, side: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let style = TextStyle::from(("sans-serif", 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        let mut y = 60;
+        for s in self.series.iter().filter(|s| !s.label.is_empty()) {
+            let c = s.color;
+            match s.kind {
+                Kind::Markers => side.draw(&Circle::new((14, y), 4, c.filled())).map_err(e)?,
+                _ => side.draw(&PathElement::new(vec![(4, y), (26, y)], c.stroke_width(3))).map_err(e)?,
+            }
+            side.draw(&Text::new(s.label.clone(), (32, y), style.clone())).map_err(e)?;
+            y += 22;
+        }
+        Ok(())
+    }
+
+    fn draw_plot<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let ((x0, x1), (y0, y1)) = self.bounds();
         match (self.log_x, self.log_y) {
             (false, false) => self.draw_in(root, x0..x1, y0..y1),
@@ -271,7 +321,7 @@ impl Chart {
                     .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
                     .map_err(e)?,
             };
-            if !s.label.is_empty() {
+            if !s.label.is_empty() && !self.legend_right {
                 any_label = true;
                 anno.label(s.label.clone())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(3)));
@@ -883,10 +933,19 @@ pub fn bar_chart_png(
     // Room under the zero line for the category names.
     let (y0, y1) = (lo - 3.0 * pad, hi + pad);
     let width = (160 * n as u32 + 200).clamp(700, 1600);
-    let root = BitMapBackend::new(path, (width, 620)).into_drawing_area();
+    // The legend gets a column of its own right of the bars, so that it never covers one.
+    let legend_w = 36 + 7 * series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0) as u32;
+    let picture = BitMapBackend::new(path, (width + legend_w, 620)).into_drawing_area();
+    let (root, side) = picture.split_horizontally(width);
     let draw = || -> Result<(), String> {
         let e = |e: DrawingAreaErrorKind<_>| e.to_string();
-        root.fill(&WHITE).map_err(e)?;
+        picture.fill(&WHITE).map_err(e)?;
+        let style = TextStyle::from(("sans-serif", 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        for (si, s) in series.iter().enumerate() {
+            let (color, y) = (PALETTE[si % PALETTE.len()], 60 + 22 * si as i32);
+            side.draw(&Rectangle::new([(6, y - 5), (20, y + 5)], color.filled())).map_err(e)?;
+            side.draw(&Text::new(s.label.to_owned(), (28, y), style.clone())).map_err(e)?;
+        }
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(14)
@@ -917,9 +976,7 @@ pub fn bar_chart_png(
             let rects = s.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(ci, &v)| {
                 Rectangle::new([(x_of(ci) + 0.05 * bar, 0.0), (x_of(ci) + 0.95 * bar, v)], color.filled())
             });
-            let anno = chart.draw_series(rects).map_err(e)?;
-            anno.label(s.label)
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], color.filled()));
+            chart.draw_series(rects).map_err(e)?;
             let whiskers =
                 s.intervals.iter().enumerate().filter(|(_, (a, b))| a.is_finite() && b.is_finite()).map(
                     |(ci, &(a, b))| {
@@ -937,15 +994,7 @@ pub fn bar_chart_png(
             )
         });
         chart.draw_series(names).map_err(e)?;
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e)?;
-        root.present().map_err(e)
+        picture.present().map_err(e)
     };
     draw().map_err(|m| err(path, m))
 }

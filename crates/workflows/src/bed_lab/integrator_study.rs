@@ -221,7 +221,8 @@ fn write_outputs(
         let mut chart =
             Chart::new(&format!("{} — N_FM = {n_fm}", case.name()), "time step Δt (k = m = u₀ = 1)", "error")
                 .log_x()
-                .log_y();
+                .log_y()
+                .legend_right();
         for (k, r) in rows.iter().filter(|r| r.case == case && r.n_fm == n_fm).enumerate() {
             let pts: Vec<(f64, f64)> =
                 r.points.iter().filter(|p| p.1 > 0.0).map(|&(dt, e)| (dt, e.max(1e-16))).collect();
