@@ -8,7 +8,7 @@ mod run;
 pub mod setup;
 
 pub use config::*;
-pub use run::{run, run_collect, MeshWallResult, SceneResults};
+pub use run::{run, run_collect, run_collect_with, MeshWallResult, SceneResults};
 
 #[cfg(test)]
 mod tests;

@@ -102,6 +102,18 @@ pub fn run_collect(
     cfg: &SceneConfig,
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    run_collect_with(cfg, ctx, None)
+}
+
+/// Like [`run_collect`], with forces from outside the engine (e.g. the drag of a prescribed air flow
+/// through [`crate::fluid_forces::FluidForces`]) added at every force evaluation. The hook must be a
+/// function of time and the particles' state only (it is not part of the checkpoint), so that resumed
+/// runs stay bit-identical.
+pub fn run_collect_with(
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+    external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
     Checker::run(cfg, cfg.base_dir.as_deref()).map_err(DemError::Invalid)?;
     let c = &cfg.contact;
     let damping = RestitutionDamping {
@@ -119,7 +131,8 @@ pub fn run_collect(
     };
     let jkr = JkrLaw { break_criterion: c.jkr_break, damping: c.jkr_damping, coulomb: c.adhesive_coulomb };
     let r = c.rolling;
-    let built = setup::build(cfg)?;
+    let mut built = setup::build(cfg)?;
+    built.external = external;
     if built.speed_dependent_restitution() {
         // Some pair has a speed-dependent e: the damping law keeps each contact's coefficient in its
         // state (16 bytes more per contact), so it gets engines of its own; scenes with constant e only
@@ -345,6 +358,9 @@ fn run_with<L: ContactLaw>(
         sim.add_template(t);
     }
     sim.set_wear(built.wear);
+    if let Some(f) = built.external {
+        sim.set_external_forces(f);
+    }
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
     let out_every = ((cfg.output_interval_s / cfg.dt_s).round() as u64).max(1);
