@@ -9,7 +9,9 @@ pub mod setup;
 
 pub use config::*;
 pub(crate) use run::{inject, time_step_warnings};
-pub use run::{run, run_collect, simulation, with_law, MeshWallResult, SceneResults, WithLaw};
+pub use run::{
+    run, run_collect, run_collect_with, simulation, with_law, MeshWallResult, SceneResults, WithLaw,
+};
 
 #[cfg(test)]
 mod tests;

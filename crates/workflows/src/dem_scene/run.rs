@@ -102,19 +102,33 @@ pub fn run_collect(
     cfg: &SceneConfig,
     ctx: &RunContext,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    run_collect_with(cfg, ctx, None)
+}
+
+/// Like [`run_collect`], with forces from outside the engine (e.g. the drag of a prescribed air flow
+/// through [`crate::fluid_forces::FluidForces`]) added at every force evaluation. The hook must be a
+/// function of time and the particles' state only (it is not part of the checkpoint), so that resumed
+/// runs stay bit-identical.
+pub fn run_collect_with(
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+    external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
+) -> Result<(RunSummary, Option<SceneResults>), DemError> {
     Checker::run(cfg, None).map_err(DemError::Invalid)?;
-    with_law(cfg, SceneRun { cfg, ctx })
+    with_law(cfg, SceneRun { cfg, ctx, external })
 }
 
 /// The scene's own run, as a [`WithLaw`] visitor.
 struct SceneRun<'a> {
     cfg: &'a SceneConfig,
     ctx: &'a RunContext<'a>,
+    external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
 }
 
 impl WithLaw for SceneRun<'_> {
     type Output = (RunSummary, Option<SceneResults>);
-    fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError> {
+    fn with<L: ContactLaw>(self, law: L, mut built: setup::Built) -> Result<Self::Output, DemError> {
+        built.external = self.external;
         run_with(law, built, self.cfg, self.ctx)
     }
 }
@@ -353,6 +367,9 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
         sim.add_template(t);
     }
     sim.set_wear(built.wear);
+    if let Some(f) = built.external {
+        sim.set_external_forces(f);
+    }
     sim
 }
 

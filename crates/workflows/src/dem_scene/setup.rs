@@ -45,6 +45,8 @@ pub struct Built {
     /// Clump templates in the order of `[templates]` (alphabetical).
     pub templates: Vec<ClumpTemplate>,
     pub wear: WearTable,
+    /// Forces from outside the engine (a workflow's fluid drag), installed in the simulation.
+    pub external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
 }
 
 impl Built {
@@ -166,7 +168,7 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         let b = material_index(cfg, &w.wall_material, &format!("wear[{i}].wall_material"))?;
         wear.set(a as usize, b as usize, w.model());
     }
-    Ok(Built { materials, pairs, walls, templates, wear })
+    Ok(Built { materials, pairs, walls, templates, wear, external: None })
 }
 
 /// The insertion mix of a `clumps` table: the named templates with their body masses at `density`

@@ -4,8 +4,8 @@
 use super::*;
 use spatter_core::check::Checker;
 use spatter_core::control::{Finished, StopAfterPolls, Unattended};
-use spatter_io::run::{RunContext, RunDir};
 use spatter_core::Vec3;
+use spatter_io::run::{RunContext, RunDir};
 use std::path::Path;
 
 /// A small pour: a box of planes, an STL floor, a lattice fill and an injector, with rolling resistance.

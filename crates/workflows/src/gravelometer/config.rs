@@ -5,7 +5,9 @@
 //! preset value is an assumption (the published study does not give it) and which the file did not set.
 //! Every key is documented in `docs/gravelometer.md`.
 
+use super::air::Outside;
 use crate::dem_scene::{TemplateConfig, TemplateShape};
+use crate::fluid_forces::{DragModel, KCorrection};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::Vec3;
@@ -142,6 +144,26 @@ pub struct WallKeys {
     pub coating_density_kg_m3: Option<f64>,
 }
 
+/// `[air_field]`: the prescribed air of `air = "prescribed"` (see [`super::air`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirFieldKeys {
+    /// Exponent n of the power-law pipe profile u = U_c (1 − r/R)^{1/n}.
+    pub profile_exponent: Option<f64>,
+    /// Length of the linear inlet ramp from still air to the steady flow \[s\].
+    pub ramp_s: Option<f64>,
+    /// The air beyond the pipe exit.
+    pub outside: Option<Outside>,
+    /// Drag law on every member sphere.
+    pub drag: Option<DragModel>,
+    /// Air density \[kg/m³\].
+    pub density_kg_m3: Option<f64>,
+    /// Air dynamic viscosity \[Pa s\].
+    pub viscosity_pa_s: Option<f64>,
+    /// Correction of the transverse drag of the porous multi-sphere stones (default none, K = 1).
+    pub k_correction: Option<KCorrection>,
+}
+
 /// `[wear]`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -194,6 +216,8 @@ pub struct GravelometerInput {
     pub contact: ContactKeys,
     #[serde(default)]
     pub walls: WallKeys,
+    #[serde(default)]
+    pub air_field: AirFieldKeys,
     #[serde(default)]
     pub wear: WearKeys,
     #[serde(default)]
@@ -273,6 +297,14 @@ impl From<GravelometerInput> for GravelometerConfig {
                 &p.walls.coating_density_kg_m3,
                 "walls.coating_density_kg_m3",
             );
+            let (a, pa) = (&mut i.air_field, &p.air_field);
+            f.take(&mut a.profile_exponent, &pa.profile_exponent, "air_field.profile_exponent");
+            f.take(&mut a.ramp_s, &pa.ramp_s, "air_field.ramp_s");
+            f.take(&mut a.outside, &pa.outside, "air_field.outside");
+            f.take(&mut a.drag, &pa.drag, "air_field.drag");
+            f.take(&mut a.density_kg_m3, &pa.density_kg_m3, "air_field.density_kg_m3");
+            f.take(&mut a.viscosity_pa_s, &pa.viscosity_pa_s, "air_field.viscosity_pa_s");
+            f.take(&mut a.k_correction, &pa.k_correction, "air_field.k_correction");
             f.take(&mut i.wear.k_s2_m2, &p.wear.k_s2_m2, "wear.k_s2_m2");
             let r = &mut i.results;
             f.take(&mut r.first_n, &p.results.first_n, "results.first_n");
@@ -363,6 +395,7 @@ pub fn preset(standard: Standard) -> (GravelometerInput, Vec<&'static str>) {
         "walls.poisson_ratio",
         "walls.coating_density_kg_m3",
         "wear.k_s2_m2",
+        "air_field.ramp_s",
     ];
     let common = GravelometerInput {
         standard,
@@ -398,6 +431,16 @@ pub fn preset(standard: Standard) -> (GravelometerInput, Vec<&'static str>) {
             youngs_modulus_pa: Some(2.0e11),
             poisson_ratio: Some(0.3),
             coating_density_kg_m3: Some(1200.0),
+        },
+        air_field: AirFieldKeys {
+            profile_exponent: Some(7.0),
+            ramp_s: Some(0.02),
+            outside: Some(Outside::FreeJet),
+            drag: Some(DragModel::DiFelice),
+            // Dry air at 20 °C and 101.325 kPa.
+            density_kg_m3: Some(1.204),
+            viscosity_pa_s: Some(1.81e-5),
+            k_correction: Some(KCorrection::None),
         },
         wear: WearKeys { k_s2_m2: Some(1.0) },
         results: ResultKeys {
@@ -534,16 +577,13 @@ impl Validate for GravelometerConfig {
         }
         match self.air() {
             AirMode::None => {}
-            AirMode::Prescribed => c.fail(
-                "air",
-                "air = \"prescribed\" needs the one-way fluid-force hook (drag of a flow field on DEM \
-                 bodies), which this build does not have yet; use air = \"none\" (empirical launch velocity)"
-                    .to_string(),
-            ),
+            AirMode::Prescribed => {}
             AirMode::Coupled => c.fail(
                 "air",
-                "air = \"coupled\" needs two-way CFD-DEM coupling of air and stones, which this build does not \
-                 have yet; use air = \"none\" (empirical launch velocity)"
+                "air = \"coupled\" needs two-way CFD-DEM coupling of air and stones, which the gravelometer \
+                 kind does not have: two-way coupling is the `cfd_dem` scenario kind, not yet wired to this \
+                 workflow; use air = \"prescribed\" (a developed pipe flow and free jet dragging the stones) \
+                 or air = \"none\" (empirical launch velocity)"
                     .to_string(),
             ),
         }
@@ -647,7 +687,11 @@ impl Validate for GravelometerConfig {
             pos(c, "k_h", l.k_h);
             pos(c, "air_flow_m3_s", l.air_flow_m3_s);
             if let Some(v) = l.speed_m_s {
-                c.positive("speed_m_s", v);
+                // Prescribed air may start the stones from rest (the single-particle tests).
+                match self.air() {
+                    AirMode::Prescribed => c.non_negative("speed_m_s", v),
+                    _ => c.positive("speed_m_s", v),
+                }
             }
             c.non_negative("fall_height_m", l.fall_height_m.unwrap_or(f64::NAN));
             c.in_range("feeder_restitution", l.feeder_restitution.unwrap_or(f64::NAN), 0.0, true, 1.0, true);
@@ -667,6 +711,25 @@ impl Validate for GravelometerConfig {
             pos(c, "youngs_modulus_pa", i.walls.youngs_modulus_pa);
             c.in_range("poisson_ratio", i.walls.poisson_ratio.unwrap_or(f64::NAN), 0.0, true, 0.5, false);
             pos(c, "coating_density_kg_m3", i.walls.coating_density_kg_m3);
+        });
+        c.nested("air_field", |c| {
+            let a = &i.air_field;
+            let n = a.profile_exponent.unwrap_or(f64::NAN);
+            if !(1.0..=20.0).contains(&n) {
+                c.fail(
+                    "profile_exponent",
+                    format!(
+                        "profile_exponent = {n}: the exponent n of the turbulent pipe profile (1 − r/R)^(1/n) lies \
+                         between 1 and 20 (7 near Re = 1e5, larger at higher Reynolds numbers)"
+                    ),
+                );
+            }
+            c.non_negative("ramp_s", a.ramp_s.unwrap_or(f64::NAN));
+            pos(c, "density_kg_m3", a.density_kg_m3);
+            pos(c, "viscosity_pa_s", a.viscosity_pa_s);
+            if let Some(k) = &a.k_correction {
+                c.nested("k_correction", |c| k.validate(c));
+            }
         });
         c.nested("wear", |c| pos(c, "k_s2_m2", i.wear.k_s2_m2));
         c.nested("results", |c| {

@@ -9,6 +9,7 @@
 //! [`crate::dem_scene::run_collect`] (checkpoints, resume and outputs as for any DEM scene) and reads the
 //! results from the scene's records. Keys and outputs: `docs/gravelometer.md`.
 
+pub mod air;
 pub mod config;
 pub mod geometry;
 mod results;
@@ -55,7 +56,18 @@ pub fn run(cfg: &GravelometerConfig, ctx: &RunContext) -> Result<RunSummary, Gra
         plan.feed_time,
         plan.dt
     );
-    let (mut summary, results) = crate::dem_scene::run_collect(&scfg, ctx)?;
+    let hook = scene::air_forces(cfg, &plan);
+    if let Some(a) = &plan.air {
+        tracing::info!(
+            "prescribed air: bulk {:.2} m/s, centreline {:.2} m/s, profile exponent {}, ramp {} s, outside the pipe: {:?}",
+            a.bulk,
+            a.centreline(),
+            a.exponent,
+            a.ramp,
+            a.outside
+        );
+    }
+    let (mut summary, results) = crate::dem_scene::run_collect_with(&scfg, ctx, hook)?;
     let Some(r) = results else { return Ok(summary) };
     if summary.finished != Finished::Completed {
         return Ok(summary);

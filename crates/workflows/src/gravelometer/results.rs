@@ -22,7 +22,7 @@ fn gap(x: f64) -> String {
     }
 }
 use spatter_io::plot::{bar_chart_png, field_map_png_with_lines, Bars, Chart, FieldMap};
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use std::path::Path;
 
@@ -343,6 +343,16 @@ pub fn report(
         .cell_int("strip", &strip_i)
         .write(&vtu)
         .map_err(io_err(&vtu))?;
+    // The map as a record, so that a study's gallery redraws every case's panel on one colour scale.
+    summary.maps.push(MeshMapRecord {
+        label: "panel damage".into(),
+        vtu: vtu.clone(),
+        array: "eroded_mass_per_area_kg_m2".into(),
+        view_dir: (-plan.frame.normal).to_array(),
+        up: plan.frame.up.to_array(),
+        title: format!("{}: eroded mass on the panel (seen from the pipe)", cfg.input.standard.label()),
+        colorbar_label: "eroded mass per area [kg/m²]".into(),
+    });
     summary.artifacts.push(("damage on the panel (ParaView)".into(), vtu));
 
     // Impacts outside the pipe; statistics of the first N on the panel.
@@ -530,6 +540,15 @@ fn first_stone(
     let max_height = in_pipe.iter().map(|r| r[z]).fold(f64::NEG_INFINITY, f64::max);
     if max_height.is_finite() {
         summary.scalar("first_stone_max_height_in_pipe_m", max_height);
+    }
+    // Speed along the axis and time at the pipe exit (x = 0), interpolated between the logged states.
+    if let Some(vx) = col("vx_m_s") {
+        if let Some(w) = rows.windows(2).find(|w| w[0][x] < 0.0 && w[1][x] >= 0.0) {
+            let f = -w[0][x] / (w[1][x] - w[0][x]);
+            let lerp = |c: usize| w[0][c] + f * (w[1][c] - w[0][c]);
+            summary.scalar("first_stone_exit_time_s", lerp(t));
+            summary.scalar("first_stone_exit_speed_m_s", lerp(vx));
+        }
     }
     let pipe = 2;
     let hits = r.events.objects().find(|(k, _)| *k == (true, 0)).map_or(0, |(_, rec)| rec.collisions[pipe]);

@@ -2,7 +2,8 @@
 //! templates, the launch velocity, the injector, and the event log that the results are read from. The
 //! scene then runs through the DEM scene machinery ([`crate::dem_scene::run_collect`]).
 
-use super::config::{get, GravelometerConfig, StoneShape};
+use super::air::PipeAir;
+use super::config::{get, AirMode, GravelometerConfig, StoneShape};
 use super::geometry::{self, Dimensions, PanelFrame};
 use super::GravelometerError;
 use crate::dem_scene::events::{CrossingPlane, EventsConfig, TrajectoryConfig};
@@ -10,10 +11,12 @@ use crate::dem_scene::{
     ClumpMixConfig, EngineConfig, InjectConfig, OutputConfig, Packing, PairOverride, PairValues, RatioBasis,
     RegionConfig, SceneConfig, ShapeConfig, TemplateConfig, TemplateShape, WallConfig, WearConfig, WearKind,
 };
+use crate::fluid_forces::{FluidForceOptions, FluidForces, PrescribedFlow};
 use spatter_core::material::{effective_modulus, Material};
 use spatter_core::timestep::hertz_time;
 use spatter_core::Vec3;
 use spatter_dem::clump::ClumpTemplate;
+use spatter_flow::forces::Fluid;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -26,6 +29,9 @@ pub const BOX: &str = "protection_box";
 /// Largest stone volume fraction the pipe is taken to pass at the launch speed (dense-phase conveying
 /// begins around 0.2–0.3; above it the stones would queue at the inlet).
 pub const MAX_PIPE_LOADING: f64 = 0.2;
+
+/// Gravitational acceleration \[m/s²\].
+pub const GRAVITY: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 
 /// Steps per Hertz contact of a stone on a wall (see `spatter_dem::timestep`).
 const STEPS_PER_CONTACT: f64 = 20.0;
@@ -63,6 +69,8 @@ pub struct Plan {
     pub feed_time: f64,
     /// Largest bounding radius of a stone \[m\].
     pub stone_radius: f64,
+    /// The prescribed air field (`air = "prescribed"`), else `None`.
+    pub air: Option<PipeAir>,
 }
 
 fn config_error(key: &str, message: String) -> GravelometerError {
@@ -206,22 +214,38 @@ pub fn plan(cfg: &GravelometerConfig) -> Result<Plan, GravelometerError> {
     // Pipe loading: the stone volume flux against what the pipe passes at the launch speed.
     let area = std::f64::consts::PI * r_pipe * r_pipe;
     let flux = kg_per_s / density;
-    let capacity = MAX_PIPE_LOADING * area * vh;
+    // The stones move at least at their launch speed; prescribed air drags them to the air's speed.
+    let carrier = match cfg.air() {
+        AirMode::Prescribed => vh.max(get(i.pipe.air_velocity_m_s)),
+        _ => vh,
+    };
+    let capacity = MAX_PIPE_LOADING * area * carrier;
     if flux > capacity {
         return Err(config_error(
             "stones.charge_kg",
             format!(
                 "the feed of {kg_per_s:.4} kg/s ({flux:.3e} m³/s of stone) is more than the pipe passes: at the \
-                 launch speed of {vh:.2} m/s a {} m pipe carries at most {capacity:.3e} m³/s (a stone volume \
+                 speed of {carrier:.2} m/s a {} m pipe carries at most {capacity:.3e} m³/s (a stone volume \
                  fraction of {MAX_PIPE_LOADING}); lower stones.charge_kg or stones.count, or lengthen \
                  stones.feed_time_s",
                 dims.pipe_diameter
             ),
         ));
     }
+    let air = (cfg.air() == AirMode::Prescribed).then(|| {
+        let a = &i.air_field;
+        PipeAir {
+            length: dims.pipe_length,
+            radius: r_pipe,
+            bulk: get(i.pipe.air_velocity_m_s),
+            exponent: get(a.profile_exponent),
+            ramp: get(a.ramp_s),
+            outside: get(a.outside),
+        }
+    });
     let dt = match i.dt_s {
         Some(dt) => dt,
-        None => auto_dt(cfg, &stones, launch.length()),
+        None => auto_dt(cfg, &stones, top_speed(launch, air.as_ref())),
     };
     let frame = PanelFrame::new(&dims);
     Ok(Plan {
@@ -236,7 +260,33 @@ pub fn plan(cfg: &GravelometerConfig) -> Result<Plan, GravelometerError> {
         kg_per_s,
         feed_time,
         stone_radius,
+        air,
     })
+}
+
+/// The one-way fluid forces of the prescribed air on every member sphere (drag by `air_field.drag`,
+/// the K-correction, Archimedes buoyancy), or `None` without prescribed air.
+pub fn air_forces(
+    cfg: &GravelometerConfig,
+    plan: &Plan,
+) -> Option<Box<dyn spatter_dem::sim::ExternalForces>> {
+    let air = plan.air?;
+    let a = &cfg.input.air_field;
+    let fluid = Fluid { density: get(a.density_kg_m3), viscosity: get(a.viscosity_pa_s) };
+    let options = FluidForceOptions {
+        fluid,
+        drag: get(a.drag),
+        k_correction: get(a.k_correction),
+        pressure_force: true,
+    };
+    let sampler = PrescribedFlow::new(air, fluid.density, GRAVITY);
+    Some(Box::new(FluidForces::new(sampler, options)))
+}
+
+/// The fastest a stone is expected to fly \[m/s\]: its launch speed, or the air's centreline speed
+/// when prescribed air is faster.
+pub fn top_speed(launch: Vec3, air: Option<&PipeAir>) -> f64 {
+    launch.length().max(air.map_or(0.0, |a| a.centreline()))
 }
 
 fn stone_material(cfg: &GravelometerConfig) -> Material {
@@ -350,13 +400,13 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         dt_s: plan.dt,
         duration_s: get(i.duration_s),
         output_interval_s: out_interval,
-        gravity_m_s2: Vec3::new(0.0, 0.0, -9.81),
+        gravity_m_s2: GRAVITY,
         seed: get(i.seed),
         contact: Default::default(),
         engine: EngineConfig {
             domain_min_m: Some(pipe_min.min(box_bounds.min) - margin),
             domain_max_m: Some(box_bounds.max + margin),
-            impact_speed_m_s: Some(1.5 * plan.launch.length().max(1.0)),
+            impact_speed_m_s: Some(1.5 * top_speed(plan.launch, plan.air.as_ref()).max(1.0)),
             ..Default::default()
         },
         materials,
