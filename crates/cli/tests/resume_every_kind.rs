@@ -444,7 +444,7 @@ shape = { type = "ball", radius_m = 2.5e-3 }
 packing = { type = "count", sphere_count = 1 }
 [launch]
 speed_m_s = 12.0
-[results]
+[output]
 particles_vtu = true
 output_interval_s = 0.002
 "#;

@@ -172,10 +172,10 @@ pub struct WearKeys {
     pub k_s2_m2: Option<f64>,
 }
 
-/// `[results]`.
+/// `[output]`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ResultKeys {
+pub struct OutputKeys {
     /// Impact statistics over the first N stones to hit the panel.
     pub first_n: Option<usize>,
     /// Report the eroded mass after this many impacts (panel, clamp or fly-over).
@@ -221,7 +221,7 @@ pub struct GravelometerInput {
     #[serde(default)]
     pub wear: WearKeys,
     #[serde(default)]
-    pub results: ResultKeys,
+    pub output: OutputKeys,
     /// Written by the loader: the keys whose value is an assumption of the preset (read back, ignored).
     #[serde(default)]
     pub assumed: Vec<String>,
@@ -306,11 +306,11 @@ impl From<GravelometerInput> for GravelometerConfig {
             f.take(&mut a.viscosity_pa_s, &pa.viscosity_pa_s, "air_field.viscosity_pa_s");
             f.take(&mut a.k_correction, &pa.k_correction, "air_field.k_correction");
             f.take(&mut i.wear.k_s2_m2, &p.wear.k_s2_m2, "wear.k_s2_m2");
-            let r = &mut i.results;
-            f.take(&mut r.first_n, &p.results.first_n, "results.first_n");
-            f.take(&mut r.cutoff_impacts, &p.results.cutoff_impacts, "results.cutoff_impacts");
-            f.take(&mut r.particles_vtu, &p.results.particles_vtu, "results.particles_vtu");
-            f.take(&mut r.output_interval_s, &p.results.output_interval_s, "results.output_interval_s");
+            let r = &mut i.output;
+            f.take(&mut r.first_n, &p.output.first_n, "output.first_n");
+            f.take(&mut r.cutoff_impacts, &p.output.cutoff_impacts, "output.cutoff_impacts");
+            f.take(&mut r.particles_vtu, &p.output.particles_vtu, "output.particles_vtu");
+            f.take(&mut r.output_interval_s, &p.output.output_interval_s, "output.output_interval_s");
         }
         // Generated template shapes without a packing of their own take the member spheres.
         if let (Some(m), Some(ts)) = (input.stones.member_diameter_m, input.stones.templates.as_mut()) {
@@ -443,7 +443,7 @@ pub fn preset(standard: Standard) -> (GravelometerInput, Vec<&'static str>) {
             k_correction: Some(KCorrection::None),
         },
         wear: WearKeys { k_s2_m2: Some(1.0) },
-        results: ResultKeys {
+        output: OutputKeys {
             first_n: Some(30),
             cutoff_impacts: Some(40),
             particles_vtu: Some(true),
@@ -732,14 +732,14 @@ impl Validate for GravelometerConfig {
             }
         });
         c.nested("wear", |c| pos(c, "k_s2_m2", i.wear.k_s2_m2));
-        c.nested("results", |c| {
-            if i.results.first_n == Some(0) {
+        c.nested("output", |c| {
+            if i.output.first_n == Some(0) {
                 c.fail("first_n", "first_n = 0: the statistics need at least one stone".to_string());
             }
-            if i.results.cutoff_impacts == Some(0) {
+            if i.output.cutoff_impacts == Some(0) {
                 c.fail("cutoff_impacts", "cutoff_impacts = 0: give at least one impact".to_string());
             }
-            pos(c, "output_interval_s", i.results.output_interval_s);
+            pos(c, "output_interval_s", i.output.output_interval_s);
         });
     }
 }
@@ -764,6 +764,6 @@ impl spatter_io::run::Smoke for GravelometerConfig {
         let launch = i.launch.speed_m_s.unwrap_or(10.0).max(5.0);
         let flight = 0.12 / launch;
         i.duration_s = Some(i.duration_s.unwrap_or(1.0).min(flight + 0.004));
-        i.results.output_interval_s = Some(i.duration_s.unwrap_or(0.02) / 4.0);
+        i.output.output_interval_s = Some(i.duration_s.unwrap_or(0.02) / 4.0);
     }
 }

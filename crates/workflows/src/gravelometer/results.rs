@@ -357,7 +357,7 @@ pub fn report(
 
     // Impacts outside the pipe; statistics of the first N on the panel.
     let all = impacts(r, plan, &walls);
-    let n = get(cfg.input.results.first_n);
+    let n = get(cfg.input.output.first_n);
     let first: Vec<&Impact> = all.iter().filter(|i| i.wall == 0).take(n).collect();
     let template_name = |k: usize| plan.stones.get(k).map_or("?".to_string(), |s| s.name.clone());
     let rows: Vec<Vec<String>> = all
@@ -450,7 +450,7 @@ pub fn report(
         summary.scalar("pipe_collisions_per_stone", pipe_hits as f64 / all.len() as f64);
     }
     // Eroded mass after K impacts (panel, clamp or fly-over into the box, as counted in the study).
-    let k = get(cfg.input.results.cutoff_impacts);
+    let k = get(cfg.input.output.cutoff_impacts);
     summary.scalar("impacts_counted", all.len() as f64);
     if all.len() >= k {
         let t_k = all[k - 1].t;

@@ -395,7 +395,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         interval_s: (0.5 * region_height / vh).max(plan.dt).min(plan.feed_time),
         attempts: 200,
     };
-    let out_interval = get(i.results.output_interval_s);
+    let out_interval = get(i.output.output_interval_s);
     SceneConfig {
         dt_s: plan.dt,
         duration_s: get(i.duration_s),
@@ -430,7 +430,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
             threshold_j: 0.0,
         }],
         output: OutputConfig {
-            particles_vtu: get(i.results.particles_vtu),
+            particles_vtu: get(i.output.particles_vtu),
             mesh_vtu: true,
             events: Some(EventsConfig {
                 angle_plane_normal: Some(Vec3::Y),

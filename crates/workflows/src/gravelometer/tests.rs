@@ -42,7 +42,7 @@ fn presets_carry_the_published_set_ups_and_name_what_is_assumed() {
     assert_eq!((din.stones.charge_kg, din.stones.feed_time_s), (Some(0.5), Some(10.0)));
     assert_eq!(din.duration_s, Some(1.0));
     assert_eq!(din.launch.k_h, Some(59.6));
-    assert_eq!((din.results.first_n, din.results.cutoff_impacts), (Some(30), Some(40)));
+    assert_eq!((din.output.first_n, din.output.cutoff_impacts), (Some(30), Some(40)));
     let sae = load("standard = \"sae_j400\"").input;
     assert_eq!(sae.pipe.diameter_m, Some(0.052));
     assert_eq!(sae.pipe.air_velocity_m_s, Some(31.1));
@@ -171,7 +171,7 @@ packing = {{ type = "count", sphere_count = 1 }}
 [launch]
 fall_height_m = 0.0
 {launch}
-[results]
+[output]
 particles_vtu = false
 output_interval_s = 0.001
 "#
@@ -390,7 +390,7 @@ speed_m_s = 0.0
 fall_height_m = 0.0
 [air_field]
 ramp_s = 0.01
-[results]
+[output]
 particles_vtu = false
 output_interval_s = 0.01
 "#
