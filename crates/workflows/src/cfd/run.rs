@@ -21,7 +21,7 @@ use super::config::{
 };
 use serde::{Deserialize, Serialize};
 use spatter_cfd::grid::Grid;
-use spatter_cfd::output::{axis_names, kinetic_energy, probe, speed_slice, to_vtr};
+use spatter_cfd::output::{axis_names, kinetic_energy, probe, speed_slice, to_vtr, Slice};
 use spatter_cfd::pcg::PcgSettings;
 use spatter_cfd::{cavity, Boundary, Flow, FlowError, Fluid, Mode, Numerics};
 use spatter_core::check::{Checker, Invalid};
@@ -50,6 +50,27 @@ pub enum FlowRunError {
 
 pub(crate) fn io_at(path: &Path) -> impl Fn(std::io::Error) -> FlowRunError + '_ {
     move |e| FlowRunError::Io(format!("{}: {e}", path.display()))
+}
+
+/// Draws `values` (one per cell of the cut `slice`, row by row) as a colour map into `png`.
+pub(crate) fn cut_png(
+    png: &Path,
+    slice: &Slice,
+    values: &[f64],
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    colorbar_label: &str,
+) -> Result<(), FlowRunError> {
+    let map = FieldMap {
+        x_faces: &slice.h_faces,
+        y_faces: &slice.v_faces,
+        values,
+        title,
+        x_label,
+        y_label,
+        colorbar_label,
+    };
+    field_map_png(png, &map).map_err(io_at(png))
 }
 
 /// Builds the flow of a scenario (grid, blocked cells, boundaries, numerics, turbulence, actuator disks),
@@ -414,19 +435,7 @@ fn finish(
     );
     let (xl, yl) = (format!("{} [m]", names[slice.axes[0]]), format!("{} [m]", names[slice.axes[1]]));
     let png = dir.path("speed.png");
-    field_map_png(
-        &png,
-        &FieldMap {
-            x_faces: &slice.h_faces,
-            y_faces: &slice.v_faces,
-            values: &slice.speed,
-            title: &title,
-            x_label: &xl,
-            y_label: &yl,
-            colorbar_label: "speed |u| [m/s]",
-        },
-    )
-    .map_err(io_at(&png))?;
+    cut_png(&png, &slice, &slice.speed, &title, (&xl, &yl), "speed |u| [m/s]")?;
     s.artifacts.push(("speed on the cut".into(), png));
     s.artifacts.push(("fields (ParaView)".into(), dir.path("fields.pvd")));
     s.artifacts.push(("series".into(), dir.path("series.csv")));

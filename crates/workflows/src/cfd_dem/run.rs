@@ -16,7 +16,7 @@
 
 use super::config::CfdDemConfig;
 use super::{Coupled, CouplingError, CouplingTimes};
-use crate::cfd::run::{io_at, max_speed};
+use crate::cfd::run::{cut_png, io_at, max_speed};
 use crate::cfd::{build_domain, FlowDomain, FlowRunError};
 use crate::dem_scene::{inject, setup, time_step_warnings, with_law, WithLaw};
 use serde::{Deserialize, Serialize};
@@ -31,7 +31,7 @@ use spatter_dem::insertion::InjectorState;
 use spatter_dem::output::write_particles;
 use spatter_dem::sim::{SimState, Simulation};
 use spatter_io::csv::CsvSeries;
-use spatter_io::plot::{field_map_png, Chart, FieldMap};
+use spatter_io::plot::Chart;
 use spatter_io::pvd::PvdSeries;
 use spatter_io::run::{RunContext, RunSummary};
 use std::path::Path;
@@ -565,19 +565,7 @@ fn finish<L: ContactLaw>(
     let (xl, yl) = (format!("{} [m]", names[slice.axes[0]]), format!("{} [m]", names[slice.axes[1]]));
     let png = dir.path("speed.png");
     let title = format!("{prefix}superficial fluid speed at t = {:.4} s, {cut}", flow.state.t);
-    field_map_png(
-        &png,
-        &FieldMap {
-            x_faces: &slice.h_faces,
-            y_faces: &slice.v_faces,
-            values: &slice.speed,
-            title: &title,
-            x_label: &xl,
-            y_label: &yl,
-            colorbar_label: "speed |U| [m/s]",
-        },
-    )
-    .map_err(io_at(&png))?;
+    cut_png(&png, &slice, &slice.speed, &title, (&xl, &yl), "speed |U| [m/s]")?;
     s.artifacts.push(("fluid speed on the cut".into(), png));
     // The void fraction on the same cut (NaN in solids, drawn grey).
     let l = g.layout;
@@ -594,19 +582,7 @@ fn finish<L: ContactLaw>(
     }
     let png = dir.path("void_fraction.png");
     let title = format!("{prefix}void fraction at t = {:.4} s, {cut}", flow.state.t);
-    field_map_png(
-        &png,
-        &FieldMap {
-            x_faces: &slice.h_faces,
-            y_faces: &slice.v_faces,
-            values: &alpha,
-            title: &title,
-            x_label: &xl,
-            y_label: &yl,
-            colorbar_label: "void fraction α [-]",
-        },
-    )
-    .map_err(io_at(&png))?;
+    cut_png(&png, &slice, &alpha, &title, (&xl, &yl), "void fraction α [-]")?;
     s.artifacts.push(("void fraction on the cut".into(), png));
     // Pressure drop and bed height over time, read back from the series.
     let series_path = dir.path("series.csv");
