@@ -11,6 +11,8 @@
 //! * [`distribution`] — particle size distributions;
 //! * [`timestep`] — Rayleigh and Hertz time-step estimates;
 //! * [`control`] — how a long run learns it should stop and reports progress;
+//! * [`comm`] — the ranks of a run split over processes (MPI) or threads, and their collectives;
+//! * [`rcb`] — recursive coordinate bisection: which rank owns which part of space;
 //! * [`rng`] — seeded, serialisable random number generators;
 //! * [`check`] — physical validation of inputs with the key path of every bad value;
 //! * [`regime`] — the stick/bounce wall rule (regime-map JSON) shared by the snow workflow and trackers;
@@ -20,6 +22,7 @@
 
 pub mod aabb;
 pub mod check;
+pub mod comm;
 pub mod control;
 pub mod distribution;
 pub mod grid;
@@ -27,6 +30,7 @@ pub mod material;
 pub mod math;
 pub mod mesh;
 pub mod motion;
+pub mod rcb;
 pub mod regime;
 pub mod rng;
 pub mod shapes;
