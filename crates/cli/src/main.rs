@@ -193,7 +193,29 @@ enum SweepAction {
 }
 
 fn main() -> ExitCode {
+    // Before anything else: under mpirun every rank starts here, and MPI must be up before the first
+    // collective; `launch` lives until `main` returns (dropping it finalises MPI).
+    let launch = match spatter_mpi::init() {
+        Ok(l) => l,
+        Err(e) => {
+            if e.rank == 0 {
+                eprintln!("error: {e}");
+            }
+            return ExitCode::from(commands::EXIT_BAD_INPUT);
+        }
+    };
+    let comm = launch.comm();
     let cli = Cli::parse();
+    if comm.size() > 1 && !matches!(cli.command, Command::Run { .. }) {
+        if comm.is_root() {
+            eprintln!(
+                "error: under mpirun ({} ranks) only `spatter run` can be started; run the other commands \
+                 without mpirun",
+                comm.size()
+            );
+        }
+        return ExitCode::from(commands::EXIT_BAD_INPUT);
+    }
     let result = match cli.command {
         Command::Run {
             scenario,
@@ -216,7 +238,7 @@ fn main() -> ExitCode {
                 quiet,
                 smoke,
             };
-            commands::run::run_file(&scenario, &args)
+            commands::run::run_file_on(&scenario, &args, comm)
         }
         Command::Check { scenario } => commands::check(&scenario),
         Command::Demo { out, threads } => commands::run::demo(&out, threads),

@@ -5,6 +5,7 @@
 
 use crate::checkpoint::CheckpointError;
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::control::{Finished, RunControl};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -63,12 +64,14 @@ pub struct RunContext<'a> {
     /// Hash of the resolved input ([`crate::checkpoint::fnv1a`] of `run.toml`), stamped into every
     /// checkpoint and checked on resume; 0 when the job runs without an input file (library use).
     pub input_hash: u64,
+    /// The ranks this run is split over (one, [`SERIAL`], unless started by `mpirun`).
+    pub comm: &'a dyn Comm,
 }
 
 impl<'a> RunContext<'a> {
-    /// A context without an input hash (checkpoints are not stamped, any checkpoint is accepted).
+    /// A one-rank context without an input hash (checkpoints are not stamped, any checkpoint is accepted).
     pub fn new(dir: &'a RunDir, control: &'a dyn RunControl, resume: bool) -> Self {
-        RunContext { dir, control, resume, input_hash: 0 }
+        RunContext { dir, control, resume, input_hash: 0, comm: &SERIAL }
     }
 
     /// Writes `state` to `dir/checkpoint.bin` atomically, stamped with [`RunContext::input_hash`].

@@ -14,6 +14,7 @@
 
 use crate::kinds::{Loaded, RunError};
 use serde_json::Value;
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::control::{Finished, RunControl};
 use spatter_io::checkpoint::fnv1a;
 use spatter_io::run::{RunContext, RunDir, RunSummary};
@@ -78,6 +79,9 @@ pub enum JobError {
     /// The run ended but its results hold NaN or infinity.
     #[error("{0}")]
     NonFinite(String),
+    /// The scenario cannot run on the ranks it was started on (`mpirun -n N`).
+    #[error("{0}")]
+    Ranks(String),
 }
 
 /// Hash of a resolved input text, stamped into checkpoints.
@@ -88,6 +92,26 @@ pub fn input_hash(resolved: &str) -> u64 {
 
 /// Runs `loaded` into `opts.out` (see the module docs) and returns its summary.
 pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Result<RunSummary, JobError> {
+    run_with_comm(loaded, opts, control, &SERIAL)
+}
+
+/// [`run`] on the ranks of `comm` (a run started by `mpirun`). Every rank calls it and every rank returns
+/// the same error. No kind is split over ranks yet, so several ranks are refused before the run folder is
+/// touched; one rank is the ordinary run.
+pub fn run_with_comm(
+    loaded: &Loaded,
+    opts: &JobOptions,
+    control: &dyn RunControl,
+    comm: &dyn Comm,
+) -> Result<RunSummary, JobError> {
+    if comm.size() > 1 {
+        return Err(JobError::Ranks(format!(
+            "started on {} ranks, but kind `{}` runs in one process (no kind is split over MPI ranks yet); \
+             start it without mpirun, with --threads for the cores of this machine",
+            comm.size(),
+            loaded.scenario.kind()
+        )));
+    }
     if !(opts.checkpoint_interval_s > 0.0 && opts.checkpoint_interval_s.is_finite()) {
         return Err(JobError::Folder(format!(
             "checkpoint interval {} s: expected a positive number of seconds",
@@ -102,7 +126,7 @@ pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Resu
     // The job's log; whatever log was open before (a study's own) is open again afterwards.
     let previous_log = spatter_io::runlog::current();
     spatter_io::runlog::open(&dir.root().join("log.txt"), opts.resume)?;
-    let result = run_in(loaded, &dir, opts, control, hash, earlier_wall_s);
+    let result = run_in(loaded, &dir, opts, control, comm, hash, earlier_wall_s);
     if let Err(e) = &result {
         tracing::error!("{e}");
     }
@@ -118,6 +142,7 @@ fn run_in(
     dir: &RunDir,
     opts: &JobOptions,
     control: &dyn RunControl,
+    comm: &dyn Comm,
     hash: u64,
     earlier_wall_s: f64,
 ) -> Result<RunSummary, JobError> {
@@ -131,7 +156,7 @@ fn run_in(
     );
     tracing::info!("threads: {}", rayon::current_num_threads());
     let timed = Timed::new(control, Duration::from_secs_f64(opts.checkpoint_interval_s));
-    let ctx = RunContext { dir, control: &timed, resume: opts.resume, input_hash: hash };
+    let ctx = RunContext { dir, control: &timed, resume: opts.resume, input_hash: hash, comm };
     let started = Instant::now();
     let summary = loaded.scenario.run(&ctx).map_err(JobError::Run)?;
     let wall = earlier_wall_s + started.elapsed().as_secs_f64();
@@ -351,5 +376,27 @@ mod tests {
         s.scalar("total_J", f64::NEG_INFINITY);
         let msg = check_finite(dir.path(), &s).unwrap_err().to_string();
         assert!(msg.contains("total_J") && msg.contains("-inf"), "{msg}");
+    }
+
+    /// Started on two ranks, every rank refuses the run with the same sentence and the run folder is
+    /// never created; one rank of a rank-aware world is the ordinary run.
+    #[test]
+    fn several_ranks_are_refused_by_every_rank_before_the_folder_is_touched() {
+        use spatter_core::comm::ThreadComm;
+        use spatter_core::control::Unattended;
+        let dir = tempfile::tempdir().unwrap();
+        let text = include_str!("../../../examples/snow_single.toml");
+        let loaded = crate::load_str(Path::new("snow_single.toml"), text).unwrap();
+        let out = dir.path().join("run");
+        let opts = JobOptions::new(&out);
+        let errors =
+            ThreadComm::run(2, |c| run_with_comm(&loaded, &opts, &Unattended, c).unwrap_err().to_string());
+        assert_eq!(errors[0], errors[1]);
+        assert!(
+            errors[0].contains("started on 2 ranks") && errors[0].contains("without mpirun"),
+            "{}",
+            errors[0]
+        );
+        assert!(!out.exists());
     }
 }

@@ -4,6 +4,7 @@
 use super::{report_errors, EXIT_BAD_INPUT};
 use crate::control::{install_signal_handler, CliControl};
 use anyhow::{Context, Result};
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::control::Finished;
 use spatter_scenario::job::{self, JobError, JobOptions};
 use spatter_scenario::Loaded;
@@ -51,20 +52,33 @@ impl Default for RunArgs {
 
 /// `spatter run <scenario>`.
 pub fn run_file(path: &Path, args: &RunArgs) -> Result<ExitCode> {
+    run_file_on(path, args, &SERIAL)
+}
+
+/// `spatter run <scenario>` on the ranks of `comm` (started by `mpirun`): every rank reads the scenario,
+/// only rank 0 prints.
+pub fn run_file_on(path: &Path, args: &RunArgs, comm: &dyn Comm) -> Result<ExitCode> {
     let mut loaded = match spatter_scenario::load(path) {
         Ok(l) => l,
         Err(errors) => {
-            report_errors(&errors);
+            if comm.is_root() {
+                report_errors(&errors);
+            }
             return Ok(ExitCode::from(EXIT_BAD_INPUT));
         }
     };
     if args.smoke {
         loaded.scenario.smoke();
-        eprintln!("note: --smoke: a reduced run of {} (see run.toml for the values used)", path.display());
+        if comm.is_root() {
+            eprintln!(
+                "note: --smoke: a reduced run of {} (see run.toml for the values used)",
+                path.display()
+            );
+        }
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(path));
     let again = format!("spatter run {} --out {} --resume", path.display(), out.display());
-    execute(loaded, &out, args, &again)
+    execute(loaded, &out, args, &again, comm)
 }
 
 /// `spatter demo`: the built-in scenario; an earlier demo in the same folder is replaced.
@@ -78,7 +92,7 @@ pub fn demo(out: &Path, threads: Option<usize>) -> Result<ExitCode> {
     })?;
     println!("spatter demo: running the built-in scenario `{name}` ({})", loaded.scenario.kind());
     let args = RunArgs { threads, overwrite: true, ..RunArgs::default() };
-    execute(loaded, out, &args, &format!("spatter run {name} --out {} --resume", out.display()))
+    execute(loaded, out, &args, &format!("spatter run {name} --out {} --resume", out.display()), &SERIAL)
 }
 
 fn default_out(scenario: &Path) -> PathBuf {
@@ -102,11 +116,20 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
     rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("cannot set up worker threads")
 }
 
-fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Result<ExitCode> {
+fn execute(
+    loaded: Loaded,
+    out: &Path,
+    args: &RunArgs,
+    resume_hint: &str,
+    comm: &dyn Comm,
+) -> Result<ExitCode> {
+    // Under mpirun every rank runs this; rank 0 alone talks to the user.
+    let root = comm.is_root();
+    let quiet = args.quiet || !root;
     set_threads(args.threads)?;
     install_signal_handler();
-    let control = CliControl::new(args.quiet);
-    if let Some(note) = crate::logging::init(control.bar(), args.verbose, args.quiet) {
+    let control = CliControl::new(quiet);
+    if let Some(note) = crate::logging::init(control.bar(), args.verbose, quiet) {
         eprintln!("note: {note}");
     }
     let opts = JobOptions {
@@ -117,18 +140,21 @@ fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Res
         keep: Vec::new(),
     };
     let started = Instant::now();
-    let result = job::run(&loaded, &opts, &control);
+    let result = job::run_with_comm(&loaded, &opts, &control, comm);
     control.finish();
     let summary = match result {
         Ok(s) => s,
-        Err(e @ (JobError::Folder(_) | JobError::Resume(_))) => {
-            eprintln!("error: {e}");
+        Err(e @ (JobError::Folder(_) | JobError::Resume(_) | JobError::Ranks(_))) => {
+            if root {
+                eprintln!("error: {e}");
+            }
             return Ok(ExitCode::from(EXIT_BAD_INPUT));
         }
+        Err(_) if !root => return Ok(ExitCode::FAILURE),
         Err(e) => return Err(anyhow::anyhow!("{e}")),
     };
     let secs = started.elapsed().as_secs_f64();
-    if !args.quiet {
+    if !quiet {
         for line in &summary.headline {
             println!("{line}");
         }
@@ -138,14 +164,18 @@ fn execute(loaded: Loaded, out: &Path, args: &RunArgs, resume_hint: &str) -> Res
     }
     match summary.finished {
         Finished::Completed => {
-            println!("done in {secs:.1} s; results in {}", out.display());
+            if root {
+                println!("done in {secs:.1} s; results in {}", out.display());
+            }
             Ok(ExitCode::SUCCESS)
         }
         Finished::Interrupted => {
-            println!(
-                "stopped after {secs:.1} s; outputs so far are in {}. Continue with:\n  {resume_hint}",
-                out.display()
-            );
+            if root {
+                println!(
+                    "stopped after {secs:.1} s; outputs so far are in {}. Continue with:\n  {resume_hint}",
+                    out.display()
+                );
+            }
             Ok(ExitCode::from(EXIT_INTERRUPTED))
         }
     }

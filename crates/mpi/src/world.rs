@@ -1,0 +1,214 @@
+//! [`MpiComm`]: the [`Comm`] collectives over `MPI_COMM_WORLD`.
+
+use crate::{Launch, LaunchError};
+use mpi::collective::SystemOperation;
+use mpi::datatype::{Partition, PartitionMut};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use mpi::Count;
+use spatter_core::comm::Comm;
+
+/// Message tags of the two rounds of a neighbour exchange (sizes, then payloads).
+const TAG_SIZES: i32 = 0x5A11;
+const TAG_DATA: i32 = 0x5A12;
+
+/// The ranks of `MPI_COMM_WORLD`. It keeps no MPI handle (the world communicator is looked up per call),
+/// so it is `Send + Sync` without unsafe code; it must only be used while the [`Launch`] that made it lives.
+#[derive(Debug)]
+pub struct MpiComm {
+    rank: usize,
+    size: usize,
+}
+
+pub(crate) fn init(launcher_rank: usize) -> Result<Launch, LaunchError> {
+    // Funneled: rayon's worker threads compute, only the thread that runs the step calls MPI.
+    let Some((universe, _level)) = mpi::initialize_with_threading(mpi::Threading::Funneled) else {
+        return Err(LaunchError {
+            rank: launcher_rank,
+            message: "MPI was already initialised in this process".into(),
+        });
+    };
+    let world = universe.world();
+    let comm = MpiComm { rank: world.rank() as usize, size: world.size() as usize };
+    // A panic on one rank must end the whole job, never leave the other ranks waiting in a collective.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        default_hook(info);
+        eprintln!("rank {}: aborting all ranks after the error above", comm_rank());
+        SimpleCommunicator::world().abort(101);
+    }));
+    Ok(Launch { comm: Box::new(comm), _universe: Some(universe) })
+}
+
+fn comm_rank() -> i32 {
+    SimpleCommunicator::world().rank()
+}
+
+fn world() -> SimpleCommunicator {
+    SimpleCommunicator::world()
+}
+
+/// Offsets of consecutive blocks of the given sizes.
+fn displacements(counts: &[Count]) -> Vec<Count> {
+    counts
+        .iter()
+        .scan(0, |at, &c| {
+            let d = *at;
+            *at += c;
+            Some(d)
+        })
+        .collect()
+}
+
+fn count(len: usize) -> Count {
+    // MPI counts are C ints: a message above 2 GiB is a decomposition bug, not an input error.
+    Count::try_from(len).expect("an MPI message above 2^31 bytes")
+}
+
+fn split(buf: &[u8], counts: &[Count], displs: &[Count]) -> Vec<Vec<u8>> {
+    counts.iter().zip(displs).map(|(&c, &d)| buf[d as usize..(d + c) as usize].to_vec()).collect()
+}
+
+impl Comm for MpiComm {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.size
+    }
+    fn all_max_f64(&self, values: &mut [f64]) {
+        // MPI_MAX on doubles: exact in any order. A NaN is turned into +∞ first so that it wins on every
+        // rank (MPI leaves comparisons with NaN to the C library).
+        let local: Vec<f64> = values.iter().map(|&v| if v.is_nan() { f64::INFINITY } else { v }).collect();
+        let had_nan: Vec<u64> = values.iter().map(|v| u64::from(v.is_nan())).collect();
+        world().all_reduce_into(&local[..], values, SystemOperation::max());
+        let mut nan = had_nan;
+        self.all_sum_u64(&mut nan);
+        for (v, n) in values.iter_mut().zip(nan) {
+            if n > 0 {
+                *v = f64::NAN;
+            }
+        }
+    }
+    fn all_sum_u64(&self, values: &mut [u64]) {
+        let local = values.to_vec();
+        world().all_reduce_into(&local[..], values, SystemOperation::sum());
+    }
+    fn all_gather_bytes(&self, local: &[u8]) -> Vec<Vec<u8>> {
+        let w = world();
+        let mut counts = vec![0 as Count; self.size];
+        w.all_gather_into(&count(local.len()), &mut counts[..]);
+        let displs = displacements(&counts);
+        let mut buf = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+        {
+            let mut part = PartitionMut::new(&mut buf[..], &counts[..], &displs[..]);
+            w.all_gather_varcount_into(local, &mut part);
+        }
+        split(&buf, &counts, &displs)
+    }
+    fn neighbour_exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        assert_eq!(peers.len(), out.len(), "one buffer per peer");
+        let w = world();
+        let n = peers.len();
+        let sizes: Vec<u64> = out.iter().map(|b| b.len() as u64).collect();
+        let mut got_sizes = vec![0u64; n];
+        mpi::request::multiple_scope(2 * n, |scope, requests| {
+            for (k, &p) in peers.iter().enumerate() {
+                if p != self.rank {
+                    requests.add(
+                        w.process_at_rank(p as i32).immediate_send_with_tag(scope, &sizes[k], TAG_SIZES),
+                    );
+                }
+            }
+            for (k, slot) in got_sizes.iter_mut().enumerate() {
+                if peers[k] != self.rank {
+                    requests.add(
+                        w.process_at_rank(peers[k] as i32)
+                            .immediate_receive_into_with_tag(scope, slot, TAG_SIZES),
+                    );
+                }
+            }
+            let mut done = Vec::new();
+            requests.wait_all(&mut done);
+        });
+        let mut got: Vec<Vec<u8>> = got_sizes.iter().map(|&s| vec![0u8; s as usize]).collect();
+        for (k, &p) in peers.iter().enumerate() {
+            if p == self.rank {
+                got[k] = out[k].clone();
+            }
+        }
+        mpi::request::multiple_scope(2 * n, |scope, requests| {
+            for (k, &p) in peers.iter().enumerate() {
+                if p != self.rank {
+                    requests.add(w.process_at_rank(p as i32).immediate_send_with_tag(
+                        scope,
+                        &out[k][..],
+                        TAG_DATA,
+                    ));
+                }
+            }
+            for (k, buf) in got.iter_mut().enumerate() {
+                if peers[k] != self.rank {
+                    requests.add(w.process_at_rank(peers[k] as i32).immediate_receive_into_with_tag(
+                        scope,
+                        &mut buf[..],
+                        TAG_DATA,
+                    ));
+                }
+            }
+            let mut done = Vec::new();
+            requests.wait_all(&mut done);
+        });
+        got
+    }
+    fn all_to_all_bytes(&self, out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        assert_eq!(out.len(), self.size, "one buffer per rank");
+        let w = world();
+        let send_counts: Vec<Count> = out.iter().map(|b| count(b.len())).collect();
+        let mut recv_counts = vec![0 as Count; self.size];
+        w.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
+        let flat = out.concat();
+        let send_displs = displacements(&send_counts);
+        let recv_displs = displacements(&recv_counts);
+        let mut buf = vec![0u8; recv_counts.iter().map(|&c| c as usize).sum()];
+        {
+            let send = Partition::new(&flat[..], &send_counts[..], &send_displs[..]);
+            let mut recv = PartitionMut::new(&mut buf[..], &recv_counts[..], &recv_displs[..]);
+            w.all_to_all_varcount_into(&send, &mut recv);
+        }
+        split(&buf, &recv_counts, &recv_displs)
+    }
+    fn gather_bytes(&self, root: usize, local: &[u8]) -> Option<Vec<Vec<u8>>> {
+        let w = world();
+        let root_process = w.process_at_rank(root as i32);
+        let n = count(local.len());
+        if self.rank != root {
+            root_process.gather_into(&n);
+            root_process.gather_varcount_into(local);
+            return None;
+        }
+        let mut counts = vec![0 as Count; self.size];
+        root_process.gather_into_root(&n, &mut counts[..]);
+        let displs = displacements(&counts);
+        let mut buf = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+        {
+            let mut part = PartitionMut::new(&mut buf[..], &counts[..], &displs[..]);
+            root_process.gather_varcount_into_root(local, &mut part);
+        }
+        Some(split(&buf, &counts, &displs))
+    }
+    fn broadcast_bytes(&self, root: usize, buf: &mut Vec<u8>) {
+        let w = world();
+        let root_process = w.process_at_rank(root as i32);
+        let mut len = buf.len() as u64;
+        root_process.broadcast_into(&mut len);
+        buf.resize(len as usize, 0);
+        root_process.broadcast_into(&mut buf[..]);
+    }
+    fn barrier(&self) {
+        world().barrier();
+    }
+    fn abort(&self, code: i32) -> ! {
+        world().abort(code)
+    }
+}
