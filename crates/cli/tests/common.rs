@@ -33,3 +33,42 @@ pub fn rejects(name: &str, text: &[u8], expect: &[&str]) {
         assert!(err.contains(e), "{name}: expected `{e}` in:\n{err}");
     }
 }
+
+/// Files that legitimately differ between two runs of the same input: the log (timestamps), the summary
+/// and the report (wall time).
+pub const SESSION_FILES: &[&str] = &["log.txt", "summary.json", "report.html"];
+
+/// Every file of a run folder but the [`SESSION_FILES`], by path relative to `root`.
+pub fn run_files(root: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut std::collections::BTreeMap<PathBuf, Vec<u8>>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                let rel = p.strip_prefix(root).unwrap().to_owned();
+                if !SESSION_FILES.iter().any(|s| rel == Path::new(s)) {
+                    out.insert(rel, std::fs::read(&p).unwrap());
+                }
+            }
+        }
+    }
+    let mut out = std::collections::BTreeMap::new();
+    walk(root, root, &mut out);
+    out
+}
+
+/// The two run folders hold the same files (but the [`SESSION_FILES`]), byte for byte; `what` names the
+/// comparison in the failure message.
+pub fn assert_same_files(a: &Path, b: &Path, what: &str) {
+    let (fa, fb) = (run_files(a), run_files(b));
+    assert!(!fa.is_empty(), "{what}: {} holds no files", a.display());
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "{what}: the runs wrote other files"
+    );
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{what}: {} differs", name.display());
+    }
+}

@@ -4,6 +4,8 @@
 //! one sentence on rank 0, before anything is written, and never hang.
 #![cfg(feature = "mpi")]
 
+mod common;
+use common::assert_same_files;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Duration;
@@ -33,27 +35,6 @@ fn plain(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_spatter")).args(args).output().unwrap()
 }
 
-fn files(root: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<(PathBuf, Vec<u8>)>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).unwrap().to_owned();
-                // Timestamps and wall times differ between any two runs.
-                if !["log.txt", "summary.json", "report.html"].iter().any(|s| rel == Path::new(s)) {
-                    out.push((rel, std::fs::read(&p).unwrap()));
-                }
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(root, root, &mut out);
-    out.sort();
-    out
-}
-
 #[test]
 fn one_rank_under_mpirun_is_the_ordinary_run() {
     let tmp = tempfile::tempdir().unwrap();
@@ -69,12 +50,7 @@ fn one_rank_under_mpirun_is_the_ordinary_run() {
     assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
     let pb = mpirun(1, &rb.each_ref().map(String::as_str));
     assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
-    let (fa, fb) = (files(&a), files(&b));
-    assert!(!fa.is_empty());
-    assert_eq!(fa.iter().map(|f| &f.0).collect::<Vec<_>>(), fb.iter().map(|f| &f.0).collect::<Vec<_>>());
-    for ((name, x), (_, y)) in fa.iter().zip(&fb) {
-        assert!(x == y, "{} differs between a plain run and mpirun -n 1", name.display());
-    }
+    assert_same_files(&a, &b, "a plain run against mpirun -n 1");
 }
 
 #[test]

@@ -4,48 +4,9 @@
 
 mod common;
 use common::*;
-use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Output, Stdio};
-
-/// Files that legitimately differ between sessions: the log (timestamps), the summary and the report
-/// (wall time).
-const SESSION_FILES: &[&str] = &["log.txt", "summary.json", "report.html"];
-
-fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).unwrap().to_owned();
-                if !SESSION_FILES.iter().any(|s| rel == Path::new(s)) {
-                    out.insert(rel, std::fs::read(&p).unwrap());
-                }
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(root, root, &mut out);
-    out
-}
-
-fn assert_same_files(whole: &Path, parts: &Path, what: &str) {
-    let a = all_files(whole);
-    let b = all_files(parts);
-    let names_a: Vec<_> = a.keys().collect();
-    let names_b: Vec<_> = b.keys().collect();
-    assert_eq!(names_a, names_b, "{what}: the resumed run wrote other files");
-    for (name, bytes) in &a {
-        assert!(
-            bytes == &b[name],
-            "{what}: {} differs between the uninterrupted and the resumed run",
-            name.display()
-        );
-    }
-}
 
 fn run(scenario: &Path, out: &Path, extra: &[&str], envs: &[(&str, &str)]) -> Output {
     let mut c = spatter();
