@@ -10,6 +10,7 @@ pub mod error;
 pub mod insertion;
 pub mod integrators;
 pub mod output;
+pub mod packing;
 pub mod par;
 pub mod particles;
 pub mod sim;

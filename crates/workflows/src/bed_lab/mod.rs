@@ -2,6 +2,7 @@
 //! Helicopter Brownout*, PhD thesis, University of Southampton, Appendices A–C): the integrator study.
 //! Every key is documented in `docs/bed.md`.
 
+pub mod bed_file;
 pub mod integrator_study;
 
 pub use integrator_study::{run as run_integrator_study, IntegratorStudyConfig};

@@ -61,8 +61,34 @@ pub struct SceneConfig {
     /// Erosion wear of mesh walls per (particle material, wall material).
     #[serde(default)]
     pub wear: Vec<WearConfig>,
+    /// A sparse pour that builds a bed (see `docs/bed.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pour: Option<PourConfig>,
+    /// Start from the spheres of a bed file (see `docs/bed.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bed: Option<BedStart>,
     #[serde(default)]
     pub output: OutputConfig,
+}
+
+/// `[bed]`: the spheres of a bed file are placed at t = 0, before the fills.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BedStart {
+    /// The bed file (relative to the scenario file's folder), e.g. the `bed.txt` a pour wrote.
+    pub file: PathBuf,
+}
+
+/// A box whose packing density is reported (`[[output.packing]]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PackingRegion {
+    /// Name in the summary (`packing_<name>`) and in `packing.csv`.
+    pub name: String,
+    /// Lower corner \[m\].
+    pub min_m: Vec3,
+    /// Upper corner \[m\].
+    pub max_m: Vec3,
 }
 
 fn default_output_interval() -> f64 {
@@ -409,6 +435,7 @@ fn one() -> f64 {
     1.0
 }
 
+pub use super::pour::PourConfig;
 pub use crate::motions::{MotionConfig, MotionType};
 
 /// A region for fills and injections (`type = "box" | "cylinder" | "mesh"`).
@@ -541,11 +568,32 @@ pub struct OutputConfig {
     /// `trajectories.csv`: selected bodies and spheres every N steps.
     #[serde(default)]
     pub trajectories: Option<super::events::TrajectoryConfig>,
+    /// Write `bed.txt`, the free spheres at the end of the run (default: true with `[pour]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bed_file: Option<bool>,
+    /// Boxes whose packing density (solid volume fraction, spheres cut exactly by the faces) is reported
+    /// at the end of the run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub packing: Vec<PackingRegion>,
+}
+
+impl OutputConfig {
+    /// Whether `bed.txt` is written.
+    pub fn writes_bed(&self, pour: bool) -> bool {
+        self.bed_file.unwrap_or(pour)
+    }
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { particles_vtu: true, mesh_vtu: true, events: None, trajectories: None }
+        OutputConfig {
+            particles_vtu: true,
+            mesh_vtu: true,
+            events: None,
+            trajectories: None,
+            bed_file: None,
+            packing: Vec::new(),
+        }
     }
 }
 
@@ -943,7 +991,43 @@ impl Validate for SceneConfig {
             if let Some(t) = &self.output.trajectories {
                 c.nested("trajectories", |c| t.validate(c));
             }
+            if self.output.writes_bed(self.pour.is_some()) && !self.templates.is_empty() {
+                c.fail(
+                    "bed_file",
+                    "a bed file holds single spheres; this scene has clump templates — set bed_file = false"
+                        .to_string(),
+                );
+            }
+            for (i, p) in self.output.packing.iter().enumerate() {
+                c.element("packing", i, |c| {
+                    c.finite_vec("min_m", p.min_m);
+                    c.finite_vec("max_m", p.max_m);
+                    if !p.max_m.cmpgt(p.min_m).all() {
+                        c.fail("max_m", "max_m must exceed min_m in x, y and z".to_string());
+                    }
+                    if p.name.is_empty() || !p.name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
+                    {
+                        c.fail("name", format!("name = \"{}\" must be letters, digits and _", p.name));
+                    }
+                    if self.output.packing[..i].iter().any(|o| o.name == p.name) {
+                        c.fail("name", format!("name = \"{}\" is used by an earlier entry", p.name));
+                    }
+                });
+            }
         });
+        if let Some(p) = &self.pour {
+            super::pour::check(c, self, p);
+        }
+        if let Some(b) = &self.bed {
+            c.nested("bed", |c| {
+                let full = c.resolve(&b.file);
+                if !full.is_file() {
+                    c.file_exists("file", &b.file);
+                } else if let Err(e) = crate::bed_lab::bed_file::read(&full, &self.material_names()) {
+                    c.fail("file", format!("file = \"{}\": {e}", b.file.display()));
+                }
+            });
+        }
         let template_names: Vec<&str> = self.templates.keys().map(String::as_str).collect();
         for (name, t) in &self.templates {
             c.nested("templates", |c| {
@@ -1035,7 +1119,8 @@ impl Validate for SceneConfig {
 
 impl spatter_io::run::Smoke for SceneConfig {
     /// 40 steps, an output at the start, half-way and the end; fills of a counted size keep at most 200
-    /// particles (lattice and fraction fills keep their region: they are set up, not stepped, in bulk).
+    /// particles (lattice and fraction fills keep their region: they are set up, not stepped, in bulk), a
+    /// pour at most 50.
     fn smoke(&mut self) {
         self.duration_s = self.duration_s.min(40.0 * self.dt_s);
         self.output_interval_s = self.output_interval_s.min(20.0 * self.dt_s);
@@ -1043,6 +1128,9 @@ impl spatter_io::run::Smoke for SceneConfig {
             if let Some(n) = &mut f.count {
                 *n = (*n).min(200);
             }
+        }
+        if let Some(p) = &mut self.pour {
+            p.count = p.count.min(50);
         }
     }
 }

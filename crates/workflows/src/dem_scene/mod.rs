@@ -1,9 +1,11 @@
 //! Scenes: a DEM simulation described by a configuration ([`SceneConfig`], the `kind = "dem"` scenario
 //! body) and run into a run folder by [`run`], with checkpoint and bit-identical resume.
 
+mod bed_outputs;
 mod clumps;
 mod config;
 pub mod events;
+pub mod pour;
 mod run;
 pub mod setup;
 
@@ -13,5 +15,7 @@ pub use run::{
     run, run_collect, run_collect_with, simulation, with_law, MeshWallResult, SceneResults, WithLaw,
 };
 
+#[cfg(test)]
+mod pour_tests;
 #[cfg(test)]
 mod tests;

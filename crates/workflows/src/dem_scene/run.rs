@@ -40,6 +40,8 @@ struct Checkpoint<S> {
     /// The event log (empty when not kept).
     events: EventLog,
     warnings: Vec<String>,
+    /// Progress of the `[pour]` (None without one).
+    pour: Option<super::pour::PourState>,
 }
 
 /// Runs a DEM scene into `ctx.dir`: `energy.csv`, `particles.pvd` + `particles/*.vtu`, and for every mesh
@@ -404,6 +406,12 @@ fn run_with<L: ContactLaw>(
     let mut events = EventLog::default();
     let warnings: Vec<String>;
     let mut out;
+    let mut pour = cfg.pour.as_ref().map(|_| super::pour::PourState::new(cfg.seed));
+    let pour_material = match &cfg.pour {
+        Some(p) => cfg.materials.keys().position(|k| *k == p.material).unwrap_or(0) as u16,
+        None => 0,
+    };
+    let pour_every = cfg.pour.as_ref().map_or(1, |p| ((p.interval_s / cfg.dt_s).round() as u64).max(1));
     if ctx.resume {
         let ck: Checkpoint<L::State> = ctx.load_checkpoint()?;
         sim.restore(ck.sim).map_err(DemError::Resume)?;
@@ -449,6 +457,10 @@ fn run_with<L: ContactLaw>(
         };
         events = ck.events;
         warnings = ck.warnings;
+        if pour.is_some() != ck.pour.is_some() {
+            return Err(DemError::Resume("the [pour] table was added or removed".into()));
+        }
+        pour = ck.pour;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
         let initial = setup::initial_particles(cfg, &sim.walls, sim.templates())?;
@@ -504,6 +516,7 @@ fn run_with<L: ContactLaw>(
                 trajectories_csv_bytes: out.trajectories.as_ref().map_or(0, CsvSeries::bytes_written),
                 events: events.clone(),
                 warnings: warnings.clone(),
+                pour: pour.clone(),
             };
             ctx.save_checkpoint(&ck)?;
             write_events(cfg, &sim, &events, ctx)?;
@@ -523,6 +536,11 @@ fn run_with<L: ContactLaw>(
                 inject(&mut sim, inj, region, k);
             }
         }
+        if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
+            if step % pour_every == 0 && state.poured < p.count {
+                super::pour::add_next(&mut sim, p, pour_material, state)?;
+            }
+        }
         if (step + 1) % out_every == 0 || step + 1 == total_steps {
             sim.request_energy();
         }
@@ -539,6 +557,16 @@ fn run_with<L: ContactLaw>(
         }
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {
             out.write(cfg, &sim, ctx)?;
+            // A pour is checked for rest at the outputs, so that a run ending early ends on one.
+            if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
+                if state.settled_s.is_none() && super::pour::settled(&sim, p, state) {
+                    state.settled_s = Some(sim.time());
+                    tracing::info!("pour settled at t = {:.6} s", sim.time());
+                    if p.stop_when_settled {
+                        break;
+                    }
+                }
+            }
         }
         if sim.step_count() % 200 == 0 {
             ctx.control.progress(sim.step_count(), total_steps);
@@ -548,6 +576,7 @@ fn run_with<L: ContactLaw>(
     write_events(cfg, &sim, &events, ctx)?;
     let _ = std::fs::remove_file(dir.checkpoint_path());
     let mut s = summary(cfg, &sim, &injectors, &warnings, ctx);
+    super::bed_outputs::finish(cfg, &sim, pour.as_ref(), ctx, &mut s)?;
     if cfg.output.events.is_some() {
         let (hit, crossed) = events.counts();
         s.scalar("objects_hit_wall", hit as f64);

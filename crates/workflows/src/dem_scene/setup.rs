@@ -215,8 +215,8 @@ pub struct Initial {
     pub bodies: Vec<(usize, u16, NewBody)>,
 }
 
-/// The spheres and rigid bodies of the `fill` entries, in order, avoiding each other and `walls` (placed
-/// as at t = 0).
+/// The spheres of the `[bed]` file, then the spheres and rigid bodies of the `fill` entries, in order,
+/// avoiding each other, the bed and `walls` (placed as at t = 0).
 ///
 /// A random fill that cannot reach its `count` or `volume_fraction` (a drawn sphere found no free place
 /// in `max_attempts` random positions) is an error naming the key, with the number placed: running with
@@ -232,6 +232,20 @@ pub fn initial_particles(
     let clear = WallClearance::new(walls, 0.0);
     let mut placed: Vec<(Vec3, f64)> = Vec::new();
     let mut out = Initial::default();
+    if let Some(b) = &cfg.bed {
+        let names = cfg.material_names();
+        let spheres = crate::bed_lab::bed_file::read(&b.file, &names)
+            .map_err(|message| DemError::Config { key: "bed.file".into(), message })?;
+        for s in spheres {
+            let material = material_index(cfg, &s.material, "bed.file")?;
+            let mut p = NewParticle::at(s.pos, s.radius, material);
+            p.vel = s.vel;
+            p.omega = s.omega;
+            placed.push((s.pos, s.radius));
+            out.spheres.push(p);
+        }
+        tracing::info!("bed: {} spheres from {}", out.spheres.len(), b.file.display());
+    }
     for (i, f) in cfg.fill.iter().enumerate() {
         let material = material_index(cfg, &f.material, &format!("fill[{i}].material"))?;
         let reg = region(&f.region)?;

@@ -207,7 +207,8 @@ fn shipped_examples_are_valid() {
     for entry in std::fs::read_dir(&root).unwrap() {
         let p = entry.unwrap().path();
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        if !(name.starts_with("dem_") && name.ends_with(".toml")) {
+        // DEM scenes: `dem_*.toml`, and the bed laboratory's pour.
+        if !((name.starts_with("dem_") && name.ends_with(".toml")) || name == "bed_pour.toml") {
             continue;
         }
         let text = std::fs::read_to_string(&p).unwrap();
@@ -218,7 +219,7 @@ fn shipped_examples_are_valid() {
         Checker::run(&cfg, Some(&root)).unwrap_or_else(|e| panic!("{name}: {e:?}"));
         n += 1;
     }
-    assert!(n >= 1, "no examples/dem_*.toml found");
+    assert!(n >= 2, "examples/dem_*.toml and bed_pour.toml: {n} found");
 }
 
 #[test]

@@ -421,6 +421,8 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         fill: Vec::new(),
         inject: vec![inject],
         templates,
+        pour: None,
+        bed: None,
         wear: vec![WearConfig {
             particle_material: "stone".to_string(),
             wall_material: "coating".to_string(),
@@ -442,6 +444,8 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
                 ids: Vec::new(),
                 first: 1,
             }),
+            bed_file: None,
+            packing: Vec::new(),
         },
     }
 }
