@@ -7,7 +7,8 @@
 //! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
 //! * [`sources`] — momentum sources: actuator disks and point forces from particles;
-//! * [`turbulence`] — the standard k–ε model with wall functions;
+//! * [`turbulence`] — the standard and realizable k–ε models with wall functions;
+//! * [`wall_shear`] — wall shear stress and friction velocity along the no-slip sides;
 //! * [`solver`] — the projection method: Adams–Bashforth predictor, pressure correction, checks;
 //! * [`mg`] — geometric multigrid V-cycle for the pressure operator;
 //! * [`pcg`] — conjugate gradients preconditioned by that V-cycle;
@@ -35,6 +36,7 @@ pub mod solver;
 pub mod sources;
 pub mod turbulence;
 pub mod validation;
+pub mod wall_shear;
 
 pub use bc::{Boundary, TimeTable};
 pub use grid::{Axis, Grid, Mode};

@@ -285,7 +285,7 @@ impl Flow {
     pub fn memory_estimate(n: [usize; 3], with_force: bool, with_turbulence: bool) -> u64 {
         let fine = crate::grid::Layout::new(n).len() as u64;
         let per_cell =
-            8 * (16 + if with_force { 3 } else { 0 }) + 4 + if with_turbulence { 8 * 7 + 1 } else { 0 };
+            8 * (16 + if with_force { 3 } else { 0 }) + 4 + if with_turbulence { 8 * 7 + 2 } else { 0 };
         let levels: u64 = Multigrid::level_layouts(n).iter().map(|l| l.len() as u64).sum();
         fine * per_cell + levels * 8 * Multigrid::F64_PER_CELL as u64
     }
@@ -316,7 +316,7 @@ impl Flow {
     pub fn enable_k_epsilon(&mut self, model: crate::turbulence::KEpsilon) {
         let mut t = crate::turbulence::Turbulence::new(model, &self.grid, &self.bc, &self.blocked);
         let st = t.initial_state(&self.grid, &self.bc);
-        t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, &st);
+        t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, &self.state.u, &st);
         self.state.turbulence = Some(st);
         self.turbulence = Some(t);
     }
@@ -787,7 +787,7 @@ impl Flow {
         }
         self.state = state;
         if let (Some(t), Some(ts)) = (self.turbulence.as_mut(), self.state.turbulence.as_ref()) {
-            t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, ts);
+            t.fill_nu_eff(&self.grid, &self.bc, &self.blocked, self.fluid.viscosity, &self.state.u, ts);
         }
         Ok(())
     }

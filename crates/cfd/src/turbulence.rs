@@ -1,5 +1,7 @@
-//! The standard k–ε model with wall functions (Launder & Spalding 1974, "The numerical computation of
-//! turbulent flows", Comput. Methods Appl. Mech. Eng. 3:269–289).
+//! The k–ε models with wall functions: standard (Launder & Spalding 1974, "The numerical computation of
+//! turbulent flows", Comput. Methods Appl. Mech. Eng. 3:269–289) and realizable (Shih, Liou, Shabbir,
+//! Yang & Zhu 1995, "A new k–ε eddy viscosity model for high Reynolds number turbulent flows", Computers
+//! & Fluids 24:227–238).
 //!
 //! Transport of the turbulent kinetic energy k and its dissipation rate ε at the cell centres:
 //!
@@ -7,7 +9,21 @@
 //!   ∂ε/∂t + ∇·(u ε) = ∇·((ν + ν_t/σ_ε)∇ε) + (ε/k)(C₁ P_k − C₂ ε),   ν_t = C_μ k²/ε,
 //!
 //! with P_k = ν_t · 2 S_ij S_ij (plus 2(u_r/r)² in the axisymmetric mode) and the constants C_μ = 0.09,
-//! C₁ = 1.44, C₂ = 1.92, σ_k = 1.0, σ_ε = 1.3. Convection uses the face velocities of the staggered grid
+//! C₁ = 1.44, C₂ = 1.92, σ_k = 1.0, σ_ε = 1.3.
+//!
+//! **Realizable** ([`Variant::Realizable`]): the same k equation; the ε equation
+//!
+//!   ∂ε/∂t + ∇·(u ε) = ∇·((ν + ν_t/σ_ε)∇ε) + C₁ S ε − C₂ ε²/(k + √(ν ε)),
+//!
+//! with S = √(2 S_ij S_ij), C₁ = max(0.43, η/(η + 5)), η = S k/ε, C₂ = 1.9, σ_ε = 1.2, and a variable
+//! C_μ = 1/(A₀ + A_s k U*/ε) in ν_t = C_μ k²/ε: A₀ = 4.04, A_s = √6 cos φ, φ = ⅓ arccos(√6 W),
+//! W = S_ij S_jk S_ki / S̃³, S̃ = √(S_ij S_ij), U* = √(S_ij S_ij + Ω_ij Ω_ij) (the hoop strain u_r/r
+//! included in the axisymmetric mode). C_μ falls where strain is large against k/ε (stagnation points,
+//! where the standard model overproduces k, and the front of a starting jet, where it lets ν_t run away),
+//! and is 0.09 in an equilibrium log layer (S k/ε = 3.33). The wall functions and the cells next to
+//! walls keep C_μ = 0.09 (the log-law equilibrium the wall functions assume).
+//!
+//! Convection uses the face velocities of the staggered grid
 //! directly with the momentum equation's TVD scheme; time stepping is forward Euler with the destruction
 //! terms implicit (k ← (k + Δt R)/(1 + Δt ε/k)), which keeps k and ε positive.
 //!
@@ -30,10 +46,28 @@ use crate::momentum::{face_value, Convection, DirOps};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// Which k–ε model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Variant {
+    /// Launder & Spalding (1974): constant C_μ, ε production C₁ P_k ε/k.
+    #[default]
+    Standard,
+    /// Shih et al. (1995): variable C_μ, ε production C₁ S ε, destruction C₂ ε²/(k + √(νε)).
+    Realizable,
+}
+
+/// A₀ of the realizable model's C_μ (the value of Fluent's implementation, which the thesis of Jasion
+/// 2013 used; Shih et al. 1995 give 4.0).
+pub const A0_REALIZABLE: f64 = 4.04;
+
 /// Model constants and inlet turbulence.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KEpsilon {
+    /// Standard or realizable.
+    #[serde(default)]
+    pub variant: Variant,
     #[serde(default = "c_mu")]
     pub c_mu: f64,
     #[serde(default = "c1")]
@@ -80,11 +114,28 @@ impl KEpsilon {
     /// The standard constants with inlet turbulence `intensity` and `length_scale` \[m\].
     pub fn standard(intensity: f64, length_scale: f64) -> Self {
         KEpsilon {
+            variant: Variant::Standard,
             c_mu: c_mu(),
             c1: c1(),
             c2: c2(),
             sigma_k: 1.0,
             sigma_eps: sigma_eps(),
+            inlet_intensity: intensity,
+            inlet_length_scale_m: length_scale,
+        }
+    }
+
+    /// The realizable model (Shih et al. 1995: C₂ = 1.9, σ_k = 1.0, σ_ε = 1.2; C₁ is computed) with inlet
+    /// turbulence `intensity` and `length_scale` \[m\]. `c_mu` = 0.09 is kept for the wall functions and
+    /// the inlet ε.
+    pub fn realizable(intensity: f64, length_scale: f64) -> Self {
+        KEpsilon {
+            variant: Variant::Realizable,
+            c_mu: c_mu(),
+            c1: c1(),
+            c2: 1.9,
+            sigma_k: 1.0,
+            sigma_eps: 1.2,
             inlet_intensity: intensity,
             inlet_length_scale_m: length_scale,
         }
@@ -113,6 +164,62 @@ pub fn wall_viscosity(c_mu: f64, k: f64, y: f64, nu: f64) -> f64 {
     }
 }
 
+/// C_μ of the realizable model (Shih et al. 1995) for the velocity gradient `g` (g\[a\]\[b\] = ∂u_a/∂x_b,
+/// the hoop strain u_r/r in g\[2\]\[2\] when axisymmetric), k \[m²/s²\] and ε \[m²/s³\]:
+/// C_μ = 1/(A₀ + A_s k U*/ε).
+pub fn realizable_c_mu(g: &[[f64; 3]; 3], k: f64, eps: f64) -> f64 {
+    let mut s = [[0.0; 3]; 3];
+    let (mut ss, mut oo) = (0.0, 0.0);
+    for a in 0..3 {
+        for b in 0..3 {
+            s[a][b] = 0.5 * (g[a][b] + g[b][a]);
+            let o = 0.5 * (g[a][b] - g[b][a]);
+            ss += s[a][b] * s[a][b];
+            oo += o * o;
+        }
+    }
+    let mut sss = 0.0;
+    for a in 0..3 {
+        for b in 0..3 {
+            for c in 0..3 {
+                sss += s[a][b] * s[b][c] * s[c][a];
+            }
+        }
+    }
+    let st = ss.sqrt();
+    let w = if st > 0.0 { sss / (st * st * st) } else { 0.0 };
+    let phi = ((6f64.sqrt() * w).clamp(-1.0, 1.0)).acos() / 3.0;
+    let a_s = 6f64.sqrt() * phi.cos();
+    let u_star = (ss + oo).sqrt();
+    1.0 / (A0_REALIZABLE + a_s * k * u_star / eps.max(EPS_MIN))
+}
+
+/// Velocity gradient at the centre of cell `c` (g\[a\]\[b\] = ∂u_a/∂x_b from the cell-centred velocities;
+/// the hoop strain u_r/r in g\[2\]\[2\] when axisymmetric only if `hoop`).
+fn cell_gradient(grid: &Grid, u: &[Vec<f64>; 3], c: usize, hoop: bool) -> [[f64; 3]; 3] {
+    let l = grid.layout;
+    let s = l.s;
+    let m = &grid.metric;
+    let q = l.coords(c);
+    let dims = if grid.mode == Mode::Axisymmetric { 2 } else { 3 };
+    let uc = |c: usize, a: usize| 0.5 * (u[a][c] + u[a][c - s[a]]);
+    let mut g = [[0.0; 3]; 3];
+    for a in 0..dims {
+        g[a][a] = (u[a][c] - u[a][c - s[a]]) / m[a].d[q[a]];
+        for b in 0..dims {
+            if b != a {
+                let sb = s[b];
+                let span = m[b].xc[q[b] + 1] - m[b].xc[q[b] - 1];
+                g[a][b] = (uc(c + sb, a) - uc(c - sb, a)) / span;
+            }
+        }
+    }
+    if hoop && grid.mode == Mode::Axisymmetric {
+        g[2][2] = uc(c, 0) / m[0].xc[q[0]];
+    }
+    g
+}
+
 /// The turbulence state: k and ε at the cell centres (padded layout).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TurbState {
@@ -128,6 +235,8 @@ pub struct Turbulence {
     pub nu_eff: Vec<f64>,
     /// Per fluid cell next to a no-slip side: (cell, side, distance to the wall \[m\]).
     walls: Vec<(usize, usize, f64)>,
+    /// Whether a cell lies next to a no-slip side (its ν_t keeps the wall functions' C_μ).
+    at_wall: Vec<bool>,
     k_new: Vec<f64>,
     eps_new: Vec<f64>,
     /// Per cell: P_k and ε summed over its walls, and the number of walls.
@@ -165,10 +274,15 @@ impl Turbulence {
             }
         }
         let n = l.len();
+        let mut at_wall = vec![false; n];
+        for &(c, _, _) in &walls {
+            at_wall[c] = true;
+        }
         Turbulence {
             model,
             nu_eff: vec![0.0; n],
             walls,
+            at_wall,
             k_new: vec![0.0; n],
             eps_new: vec![0.0; n],
             wall_p: vec![0.0; n],
@@ -185,7 +299,7 @@ impl Turbulence {
             + self.eps_new.capacity()
             + self.wall_p.capacity()
             + self.wall_e.capacity();
-        (8 * f + self.wall_n.capacity() + 24 * self.walls.capacity()) as u64
+        (8 * f + self.wall_n.capacity() + self.at_wall.capacity() + 24 * self.walls.capacity()) as u64
     }
 
     /// Initial state: the inlet values of the fastest inlet everywhere (or a small k at rest).
@@ -235,23 +349,35 @@ impl Turbulence {
         }
     }
 
-    /// ν_eff = ν + C_μ k²/ε in fluid cells, ν in blocked cells; in the ghost cell across a wall the value
-    /// 2ν_w − ν_eff(P), so that the average over the wall face (used by the momentum diffusion) is the
-    /// wall viscosity ν_w of the log law; a copy of the neighbour across other sides.
+    /// ν_eff = ν + C_μ k²/ε in fluid cells (C_μ of the realizable model from the velocity `u`), ν in
+    /// blocked cells; in the ghost cell across a wall the value 2ν_w − ν_eff(P), so that the average over
+    /// the wall face (used by the momentum diffusion) is the wall viscosity ν_w of the log law; a copy of
+    /// the neighbour across other sides.
+    #[allow(clippy::too_many_arguments)]
     pub fn fill_nu_eff(
         &mut self,
         grid: &Grid,
         bc: &[Boundary; 6],
         blocked: &[bool],
         nu: f64,
+        u: &[Vec<f64>; 3],
         st: &TurbState,
     ) {
         let l = grid.layout;
         let c_mu = self.model.c_mu;
+        let realizable = self.model.variant == Variant::Realizable;
         for c in 0..l.len() {
             let q = l.coords(c);
             self.nu_eff[c] = if l.interior(q) && !blocked[c] {
-                nu + (c_mu * st.k[c] * st.k[c] / st.eps[c].max(EPS_MIN)).min(1e5 * nu)
+                // Next to a wall the log law's equilibrium (C_μ = 0.09) holds by assumption of the wall
+                // functions; the cell-centred gradient there (a difference across the wall's ghost) is
+                // too coarse to give the realizable C_μ.
+                let cm = if realizable && !self.at_wall[c] {
+                    realizable_c_mu(&cell_gradient(grid, u, c, true), st.k[c], st.eps[c])
+                } else {
+                    c_mu
+                };
+                nu + (cm * st.k[c] * st.k[c] / st.eps[c].max(EPS_MIN)).min(1e5 * nu)
             } else {
                 nu
             };
@@ -400,9 +526,18 @@ impl Turbulence {
                 }
             }
             let k_new = ((kc + dt * (rk + pk)) / (1.0 + dt * ec / kc)).max(K_MIN);
-            let eps_new = match eps_wall {
-                Some(ew) => ew.max(EPS_MIN),
-                None => ((ec + dt * (re + md.c1 * ec / kc * pk)) / (1.0 + dt * md.c2 * ec / kc)).max(EPS_MIN),
+            let eps_new = match (eps_wall, md.variant) {
+                (Some(ew), _) => ew.max(EPS_MIN),
+                (None, Variant::Standard) => {
+                    ((ec + dt * (re + md.c1 * ec / kc * pk)) / (1.0 + dt * md.c2 * ec / kc)).max(EPS_MIN)
+                }
+                (None, Variant::Realizable) => {
+                    let strain = s2.sqrt();
+                    let eta = strain * kc / ec;
+                    let c1 = (eta / (eta + 5.0)).max(0.43);
+                    let sink = md.c2 * ec / (kc + (nu * ec).sqrt());
+                    ((ec + dt * (re + c1 * strain * ec)) / (1.0 + dt * sink)).max(EPS_MIN)
+                }
             };
             (k_new, eps_new)
         };
@@ -420,7 +555,7 @@ impl Turbulence {
         std::mem::swap(&mut st.k, &mut self.k_new);
         std::mem::swap(&mut st.eps, &mut self.eps_new);
         self.fill_ghosts(grid, bc, t, st);
-        self.fill_nu_eff(grid, bc, blocked, nu, st);
+        self.fill_nu_eff(grid, bc, blocked, nu, u, st);
     }
 }
 
@@ -462,5 +597,31 @@ mod tests {
         assert!((nw * up / y - ut * ut).abs() < 1e-12 * ut * ut, "{} vs {}", nw * up / y, ut * ut);
         // In the viscous sublayer it is the molecular viscosity.
         assert_eq!(wall_viscosity(0.09, 1e-8, 1e-5, nu), nu);
+    }
+
+    /// Shih et al. (1995) built C_μ so that an equilibrium log layer (production = dissipation, so
+    /// (S k/ε)² C_μ = 1) keeps the standard value: in simple shear du/dy = γ (W = 0, A_s = √6 cos 30°,
+    /// U* = S = γ) at S k/ε = 3.33 it gives C_μ = 1/(4.04 + 2.1213 · 3.33) = 0.0900; without strain
+    /// 1/A₀. A strong strain (large S k/ε, as at a stagnation point) lowers it as 1/(S k/ε).
+    #[test]
+    fn realizable_c_mu_is_the_standard_value_in_an_equilibrium_log_layer() {
+        let (k, eps) = (0.3, 0.1);
+        let gamma = 3.33 * eps / k;
+        let mut g = [[0.0; 3]; 3];
+        g[0][1] = gamma;
+        let cm = realizable_c_mu(&g, k, eps);
+        assert!((cm - 1.0 / (4.04 + 6f64.sqrt() * (std::f64::consts::PI / 6.0).cos() * 3.33)).abs() < 1e-12);
+        assert!((cm - 0.0900).abs() < 2e-4, "C_mu = {cm}");
+        assert!((realizable_c_mu(&[[0.0; 3]; 3], k, eps) - 1.0 / 4.04).abs() < 1e-15);
+        // Axisymmetric stagnation-point strain (u_r = a r/2, u_z = −a z, hoop a/2) at S k/ε = 30.
+        let a: f64 = 1.0;
+        let strain = (2.0 * (0.25 + 1.0 + 0.25) * a * a).sqrt();
+        let k2 = 30.0 * eps / strain;
+        let g = [[0.5 * a, 0.0, 0.0], [0.0, -a, 0.0], [0.0, 0.0, 0.5 * a]];
+        // W = −1/√6 (φ = π/3, A_s = √6/2), U* = S̃ = S/√2.
+        let cm = realizable_c_mu(&g, k2, eps);
+        let want = 1.0 / (4.04 + 0.5 * 6f64.sqrt() * 30.0 / 2f64.sqrt());
+        assert!((cm - want).abs() < 1e-12, "C_mu = {cm}, want {want}");
+        assert!(cm < 0.5 * 0.09, "C_mu = {cm} at a stagnation point");
     }
 }

@@ -169,6 +169,7 @@ pub fn turbulent_pipe_friction(
     nr: usize,
     nz: usize,
     length: f64,
+    model: crate::turbulence::KEpsilon,
 ) -> Result<(f64, f64), crate::FlowError> {
     let grid = Grid::new(
         [Axis::uniform(0.0, 0.5, nr)?, Axis::uniform(0.0, length, nz)?, Axis::uniform(0.0, 1.0, 1)?],
@@ -191,7 +192,7 @@ pub fn turbulent_pipe_friction(
         vec![false; n],
         Numerics::default(),
     )?;
-    f.enable_k_epsilon(crate::turbulence::KEpsilon::standard(0.05, 0.07));
+    f.enable_k_epsilon(model);
     // Steady to 10⁻⁴ m/s per time unit, at most 4 flow-throughs.
     cavity::run_to_steady(&mut f, 1e-4, 4.0 * length)?;
     let p_at = |z: f64| {
@@ -218,7 +219,7 @@ const COLEBROOK: &str = "Colebrook (1939) smooth pipe; Blasius (1913) f = 0.316 
 fn turbulent_pipe(quick: bool) -> Vec<Check> {
     let case = "cfd_pipe_k_epsilon_friction";
     let (re, nr, nz) = if quick { (2e4, 8, 100) } else { (5e4, 12, 100) };
-    match turbulent_pipe_friction(re, nr, nz, 50.0) {
+    match turbulent_pipe_friction(re, nr, nz, 50.0, crate::turbulence::KEpsilon::standard(0.05, 0.07)) {
         Ok((f, _)) => vec![
             Check::relative(
                 case,
@@ -459,6 +460,22 @@ mod turbulent_tests {
             eprintln!("{} | {} | ref {} | ours {}", c.case, c.quantity, c.reference, c.ours);
             assert!(c.passed(), "{c:?}");
         }
+    }
+
+    /// The realizable model (Shih et al. 1995) in the pipe of the full validation case (Re = 5·10⁴,
+    /// 12 × 100 cells): Darcy f within 10 % of Colebrook (1939) and Blasius (1913), the accuracy usually
+    /// quoted for k–ε models with wall functions. **Fails today**: f = 0.01883, −9.9 % from Colebrook and
+    /// −10.9 % from Blasius (at Re = 2·10⁴ on 8 × 100 cells −10.3 %), about 5 % below the standard model
+    /// on the same grid; the cause is not found yet (docs/cfd.md §2). Run it with `--ignored`.
+    #[test]
+    #[ignore = "known deviation: realizable pipe friction 10-11 % low, see docs/cfd.md section 2"]
+    fn realizable_k_epsilon_pipe_friction_factor_within_ten_percent_of_colebrook_and_blasius() {
+        let re = 5e4;
+        let model = crate::turbulence::KEpsilon::realizable(0.05, 0.07);
+        let (f, uc) = turbulent_pipe_friction(re, 12, 100, 50.0, model).unwrap();
+        eprintln!("realizable: f = {f}, centreline {uc}, Colebrook {}", colebrook_smooth(re));
+        assert!((f / colebrook_smooth(re) - 1.0).abs() < 0.10, "f = {f}");
+        assert!((f / (0.316 * re.powf(-0.25)) - 1.0).abs() < 0.10, "f = {f}");
     }
 
     #[test]

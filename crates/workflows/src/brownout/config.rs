@@ -11,11 +11,16 @@ use spatter_flow::forces::Fluid;
 use spatter_flow::liftoff::entrainment::{EntrainmentModel, Threshold};
 use spatter_flow::liftoff::incipient::{PullOff, RockingSettings};
 
+pub use super::rans::{FlowChoice, RansConfig, RansTurbulence};
+
 /// A `brownout` scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BrownoutConfig {
     pub rotor: RotorConfig,
+    /// The mean flow: analytic (default) or the solved axisymmetric RANS rotor.
+    #[serde(default)]
+    pub flow: FlowChoice,
     /// Air (density, viscosity).
     #[serde(default = "thesis_air")]
     pub air: Fluid,
@@ -477,6 +482,15 @@ impl BrownoutConfig {
 impl Validate for BrownoutConfig {
     fn validate(&self, c: &mut Checker) {
         c.item("rotor", &self.rotor);
+        c.item("flow", &self.flow);
+        if matches!(self.flow, FlowChoice::Rans(_)) && self.rotor.tip_vortices {
+            c.nested("rotor", |c| {
+                c.fail(
+                    "tip_vortices",
+                    "tip_vortices = true: the analytic tip vortices belong to flow.kind = \"analytic\"; the RANS flow is the mean flow (set tip_vortices = false)",
+                )
+            });
+        }
         c.item("air", &self.air);
         c.item("ground", &self.ground);
         c.item("liftoff", &self.liftoff);
@@ -523,5 +537,10 @@ impl spatter_io::run::Smoke for BrownoutConfig {
         self.liftoff.points = self.liftoff.points.min(8);
         self.entrainment.annuli = self.entrainment.annuli.min(6);
         self.entrainment.phases = self.entrainment.phases.min(2);
+        if let FlowChoice::Rans(r) = &mut self.flow {
+            r.radial_cells = r.radial_cells.min(16);
+            r.axial_cells = r.axial_cells.min(12);
+            r.max_steps = Some(r.max_steps.map_or(20, |n| n.min(20)));
+        }
     }
 }

@@ -13,7 +13,8 @@
 //! Stopping (Ctrl-C, SIGTERM) writes `checkpoint.bin` after a whole step; `--resume` continues and gives
 //! the same files as an uninterrupted run.
 
-use super::config::BrownoutConfig;
+use super::config::{BrownoutConfig, FlowChoice};
+use crate::cfd::SolvedField;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Invalid};
 use spatter_core::control::Finished;
@@ -24,6 +25,7 @@ use spatter_flow::cloud::source::{entrainment_rates, DustSource};
 use spatter_flow::cloud::LARGE_PARTICLE_EXTINCTION;
 use spatter_flow::field::analytic::{AnalyticField, AnalyticSet};
 use spatter_flow::field::rotor::RotorDownwash;
+use spatter_flow::field::FlowField;
 use spatter_flow::forces::model::{ForceModel, ForceSwitches};
 use spatter_flow::liftoff::ground_shear::{ground_shear, GroundProbe, GroundShear, ShearMethod};
 use spatter_flow::liftoff::map::lift_off_map;
@@ -71,7 +73,131 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
     Checker::run(cfg, None).map_err(BrownoutError::Invalid)?;
     let air = cfg.air;
     let rotor = cfg.rotor.downwash(&air);
-    let r0 = rotor.radius_m;
+    let summary = RunSummary::new(Finished::Completed);
+    match &cfg.flow {
+        FlowChoice::Analytic => {
+            let field = AnalyticSet { parts: vec![AnalyticField::Rotor(rotor.clone())], turbulence: None };
+            // The mean flow (the tip vortices are a fluctuation about it): the lift-off map's field, with
+            // the gust factor standing for the fluctuations as in the thesis's mean + 2u′.
+            let mean_rotor = RotorDownwash { tip_vortices: false, ..rotor.clone() };
+            let mean_field = AnalyticSet { parts: vec![AnalyticField::Rotor(mean_rotor)], turbulence: None };
+            // With tip vortices the flux (nonlinear in u_*) is averaged over one shedding period; the mean
+            // flow is steady and needs one sample.
+            let phases = if rotor.tip_vortices { cfg.entrainment.phases } else { 1 };
+            run_on(cfg, ctx, field, &mean_field, phases, summary)
+        }
+        FlowChoice::Rans(rc) => {
+            let started = std::time::Instant::now();
+            let stop = || ctx.control.stop_requested();
+            let Some(solved) = super::rans::solve(cfg, rc, &stop)
+                .map_err(|e| BrownoutError::Invalid(vec![Invalid { key: "flow".into(), message: e }]))?
+            else {
+                let mut s = RunSummary::new(Finished::Interrupted);
+                s.headline.push("stopped during the RANS solve of the rotor flow (no checkpoint: a resumed run solves it again)".into());
+                return Ok(s);
+            };
+            let summary = rans_outputs(cfg, ctx, &solved, started.elapsed().as_secs_f64(), summary)?;
+            let field = SolvedField::new(&solved.flow);
+            let mean_field = SolvedField::new(&solved.flow);
+            run_on(cfg, ctx, field, &mean_field, 1, summary)
+        }
+    }
+}
+
+/// Writes the solved rotor flow (`rotor_flow.vtr`, `rotor_wall_shear.csv`) and its summary lines.
+fn rans_outputs(
+    cfg: &BrownoutConfig,
+    ctx: &RunContext,
+    solved: &super::rans::Solved,
+    seconds: f64,
+    mut summary: RunSummary,
+) -> Result<RunSummary, BrownoutError> {
+    let flow = &solved.flow;
+    let r0 = cfg.rotor.radius_m;
+    let vtr = ctx.dir.path("rotor_flow.vtr");
+    spatter_cfd::output::to_vtr(flow).and_then(|v| v.write(&vtr))?;
+    summary.artifacts.push(("solved rotor flow (ParaView)".into(), vtr));
+    // Induced velocity: area-weighted mean axial speed through the disk plane.
+    let ax = &flow.grid.axes[0];
+    let (mut q, mut a) = (0.0, 0.0);
+    for i in (0..ax.n()).take_while(|&i| ax.centre(i) < r0) {
+        let (r, dr) = (ax.centre(i), ax.width(i));
+        if let Some(u) = flow.velocity_at([r, solved.disk.axial_m, 0.5]) {
+            q -= u[1] * r * dr;
+            a += r * dr;
+        }
+    }
+    let vi = if a > 0.0 { q / a } else { 0.0 };
+    let wall = flow.wall_shear(2);
+    let rows: Vec<Vec<String>> = wall
+        .iter()
+        .map(|p| {
+            let near = flow.velocity_at([p.centre[0], 0.1, 0.5]).map_or(0.0, |u| u[0]);
+            [
+                p.centre[0],
+                p.centre[0] / r0,
+                p.y,
+                p.speed,
+                near,
+                p.tau_over_rho * cfg.air.density,
+                p.u_star,
+                p.y_plus,
+            ]
+            .iter()
+            .map(|&v| spatter_io::fmt_f64(v))
+            .collect()
+        })
+        .collect();
+    let csv = ctx.dir.path("rotor_wall_shear.csv");
+    spatter_io::csv::write_table(
+        &csv,
+        &[
+            "r_m",
+            "r_over_R",
+            "wall_distance_m",
+            "wall_cell_speed_m_s",
+            "radial_speed_0p1m_m_s",
+            "tau_w_pa",
+            "u_star_m_s",
+            "y_plus",
+        ],
+        &rows,
+    )?;
+    summary.artifacts.push(("ground shear of the solved flow".into(), csv));
+    let (peak, at) =
+        wall.iter().map(|p| (p.u_star, p.centre[0])).fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+    summary.headline.push(format!(
+        "RANS rotor ({}): {} after t = {:.1} s ({} steps, {seconds:.0} s wall time; last change over R/v_i {:.2e} v_i); induced velocity through the disk {vi:.3} m/s against momentum theory out of ground effect {:.3} m/s; ground friction velocity peaks at {peak:.3} m/s at r/R = {:.2}",
+        match solved.flow.turbulence.as_ref().map(|t| t.model.variant) {
+            Some(spatter_cfd::turbulence::Variant::Standard) => "standard k–ε",
+            _ => "realizable k–ε",
+        },
+        if solved.steady { "steady" } else { "not steady yet (time or step limit)" },
+        flow.state.t,
+        flow.state.step,
+        solved.change,
+        solved.v_hover,
+        at / r0
+    ));
+    summary.scalar("rans_steady", if solved.steady { 1.0 } else { 0.0 });
+    summary.scalar("rans_induced_velocity_m_s", vi);
+    summary.scalar("rans_hover_induced_velocity_m_s", solved.v_hover);
+    summary.scalar("rans_max_ground_friction_velocity_m_s", peak);
+    summary.scalar("rans_max_ground_friction_velocity_r_over_R", at / r0);
+    Ok(summary)
+}
+
+/// The lift-off map, the source and the cloud on `field` (the lift-off map on `mean_field`).
+fn run_on<F: FlowField, M: FlowField>(
+    cfg: &BrownoutConfig,
+    ctx: &RunContext,
+    field: F,
+    mean_field: &M,
+    phases: usize,
+    mut summary: RunSummary,
+) -> Result<RunSummary, BrownoutError> {
+    let air = cfg.air;
+    let r0 = cfg.rotor.radius_m;
     let g = 9.81;
     let rho_p = cfg.ground.density_kg_m3;
     let classes = cfg
@@ -79,12 +205,6 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
         .size
         .classes()
         .map_err(|e| BrownoutError::Invalid(vec![Invalid { key: "ground.size".into(), message: e }]))?;
-    let field = AnalyticSet { parts: vec![AnalyticField::Rotor(rotor.clone())], turbulence: None };
-    // The mean flow (the tip vortices are a fluctuation about it): the lift-off map's field, with the
-    // gust factor standing for the fluctuations as in the thesis's mean + 2u′.
-    let mean_rotor = RotorDownwash { tip_vortices: false, ..rotor.clone() };
-    let mean_field = AnalyticSet { parts: vec![AnalyticField::Rotor(mean_rotor)], turbulence: None };
-    let mut summary = RunSummary::new(Finished::Completed);
 
     // 1. Lift-off map on the mean flow.
     let lo = &cfg.liftoff;
@@ -101,7 +221,7 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
         method: ShearMethod::JetPeak { max_height: lo.shear_max_height_over_radius * r0, samples: 96 },
         gust: lo.gust_factor,
     };
-    let map = lift_off_map(&mean_field, &probe, r0, (&lo.diameters_m, rho_p), &air, &cfg.rocking(), 0.0);
+    let map = lift_off_map(mean_field, &probe, r0, (&lo.diameters_m, rho_p), &air, &cfg.rocking(), 0.0);
     let title = format!(
         "lift-off map: rotor R = {r0} m at z_d/R = {}, gust factor {}",
         cfg.rotor.height_over_radius, lo.gust_factor
@@ -147,9 +267,8 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
         ..src_probe.clone()
     };
     // With tip vortices the flux (nonlinear in u_*) is averaged over one shedding period, sampled at
-    // `phases` equally spaced times; the mean flow is steady and needs one sample.
-    let phases = if rotor.tip_vortices { en.phases } else { 1 };
-    let period = std::f64::consts::TAU / (rotor.blades as f64 * rotor.omega_rad_s);
+    // `phases` equally spaced times.
+    let period = std::f64::consts::TAU / (cfg.rotor.blades as f64 * cfg.rotor.omega_rad_s);
     let mut ground: Vec<GroundShear> = Vec::new();
     let mut rates: Vec<Vec<f64>> = Vec::new();
     for k in 0..phases {
@@ -268,7 +387,7 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
     };
     let n_steps = (cfg.cloud.duration_s / dt).round() as u64;
     let interval = cfg.output.interval_s;
-    let mut write_outputs = |sim: &CloudSim<AnalyticSet>,
+    let mut write_outputs = |sim: &CloudSim<F>,
                              k: &mut u64,
                              bal: &mut CsvSeries,
                              opt: &mut CsvSeries,

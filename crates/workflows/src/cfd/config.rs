@@ -269,6 +269,28 @@ pub enum TurbulenceSpec {
         /// Turbulence length scale of the inlets \[m\] (about 0.07 D for a pipe of diameter D).
         inlet_length_scale_m: f64,
     },
+    /// Realizable k–ε (Shih et al. 1995) with the same wall functions and inlet keys (`docs/cfd.md` §2).
+    RealizableKEpsilon {
+        #[serde(default = "inlet_intensity")]
+        inlet_intensity: f64,
+        inlet_length_scale_m: f64,
+    },
+}
+
+impl TurbulenceSpec {
+    /// The solver's k–ε model, or `None` when laminar.
+    pub fn k_epsilon(&self) -> Option<spatter_cfd::turbulence::KEpsilon> {
+        use spatter_cfd::turbulence::KEpsilon;
+        match *self {
+            TurbulenceSpec::Laminar => None,
+            TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } => {
+                Some(KEpsilon::standard(inlet_intensity, inlet_length_scale_m))
+            }
+            TurbulenceSpec::RealizableKEpsilon { inlet_intensity, inlet_length_scale_m } => {
+                Some(KEpsilon::realizable(inlet_intensity, inlet_length_scale_m))
+            }
+        }
+    }
 }
 
 fn inlet_intensity() -> f64 {
@@ -277,7 +299,9 @@ fn inlet_intensity() -> f64 {
 
 impl Validate for TurbulenceSpec {
     fn validate(&self, c: &mut Checker) {
-        if let TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = self {
+        if let TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m }
+        | TurbulenceSpec::RealizableKEpsilon { inlet_intensity, inlet_length_scale_m } = self
+        {
             c.in_range("inlet_intensity", *inlet_intensity, 0.0, false, 1.0, true);
             c.positive("inlet_length_scale_m", *inlet_length_scale_m);
         }

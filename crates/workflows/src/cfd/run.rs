@@ -30,7 +30,7 @@ use spatter_io::csv::{write_table, CsvSeries};
 use spatter_io::plot::{field_map_png, Chart, FieldMap};
 use spatter_io::pvd::PvdSeries;
 use spatter_io::run::{RunContext, RunSummary};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Why a flow run failed.
@@ -123,11 +123,8 @@ pub fn build_domain(d: &FlowDomain) -> Result<Flow, FlowRunError> {
     };
     let fluid = Fluid { density: d.fluid.density_kg_m3, viscosity: d.fluid.kinematic_viscosity_m2_s };
     let mut flow = Flow::new(grid, fluid, d.boundaries.sides(), blocked, numerics)?;
-    if let TurbulenceSpec::KEpsilon { inlet_intensity, inlet_length_scale_m } = *d.turbulence {
-        flow.enable_k_epsilon(spatter_cfd::turbulence::KEpsilon::standard(
-            inlet_intensity,
-            inlet_length_scale_m,
-        ));
+    if let Some(model) = d.turbulence.k_epsilon() {
+        flow.enable_k_epsilon(model);
     }
     Ok(flow)
 }
@@ -475,6 +472,29 @@ fn finish(
         ));
         s.scalar(&format!("disk_{i}_mean_axial_speed_m_s"), w);
     }
+    if g.mode == Mode::Axisymmetric {
+        for side in 0..6 {
+            let w = flow.wall_shear(side);
+            if w.is_empty() {
+                continue;
+            }
+            let name = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"][side];
+            let (csv, png) = write_wall_shear(dir.root(), name, &w, &cfg.title)?;
+            let (peak, at) =
+                w.iter()
+                    .map(|p| (p.u_star, p.centre))
+                    .fold((0.0, [0.0; 3]), |a, b| if b.0 > a.0 { b } else { a });
+            let along = if side / 2 == 0 { at[1] } else { at[0] };
+            s.headline.push(format!(
+                "wall {name}: largest friction velocity {peak:.4} m/s at {} = {along:.4} m",
+                if side / 2 == 0 { "z" } else { "r" }
+            ));
+            s.scalar(&format!("wall_{name}_max_friction_velocity_m_s"), peak);
+            s.scalar(&format!("wall_{name}_max_friction_velocity_at_m"), along);
+            s.artifacts.push((format!("wall shear along {name}"), csv));
+            s.artifacts.push((format!("friction velocity along {name}"), png));
+        }
+    }
     for p in &cfg.output.probes {
         if let Some((u, pr)) = probe(flow, p.at_m) {
             for (k, q) in ["ux_m_s", "uy_m_s", "uz_m_s"].iter().enumerate() {
@@ -484,6 +504,56 @@ fn finish(
         }
     }
     Ok(s)
+}
+
+/// Writes `wall_shear_<name>.csv` (one row per wall cell along an axisymmetric wall) and
+/// `wall_shear_<name>.png` (friction velocity and wall-cell speed against the coordinate along the wall).
+fn write_wall_shear(
+    root: &Path,
+    name: &str,
+    w: &[spatter_cfd::wall_shear::WallPoint],
+    title: &str,
+) -> Result<(PathBuf, PathBuf), FlowRunError> {
+    let csv = root.join(format!("wall_shear_{name}.csv"));
+    let rows: Vec<Vec<String>> = w
+        .iter()
+        .map(|p| {
+            [p.centre[0], p.centre[1], p.y, p.speed, p.tau_over_rho, p.u_star, p.y_plus]
+                .iter()
+                .map(|&v| spatter_io::fmt_f64(v))
+                .collect()
+        })
+        .collect();
+    write_table(
+        &csv,
+        &["x_m", "y_m", "wall_distance_m", "speed_m_s", "tau_over_rho_m2_s2", "u_star_m_s", "y_plus"],
+        &rows,
+    )
+    .map_err(io_at(&csv))?;
+    let along = |p: &spatter_cfd::wall_shear::WallPoint| {
+        if name.starts_with('x') {
+            p.centre[1]
+        } else {
+            p.centre[0]
+        }
+    };
+    let png = root.join(format!("wall_shear_{name}.png"));
+    let us: Vec<(f64, f64)> = w.iter().map(|p| (along(p), p.u_star)).collect();
+    let sp: Vec<(f64, f64)> = w.iter().map(|p| (along(p), 0.1 * p.speed)).collect();
+    Chart::new(
+        &format!(
+            "{}wall {name}: friction velocity and wall-cell speed",
+            if title.is_empty() { String::new() } else { format!("{title}: ") }
+        ),
+        if name.starts_with('x') { "axial position [m]" } else { "r [m]" },
+        "u* [m/s]; speed / 10 [m/s]",
+    )
+    .size(900, 600)
+    .line("friction velocity u*", &us)
+    .line("wall-cell speed / 10", &sp)
+    .save_png(&png)
+    .map_err(io_at(&png))?;
+    Ok((csv, png))
 }
 
 /// Area-weighted mean of the axial velocity over the disk's radius at its axial position, sampled at the
