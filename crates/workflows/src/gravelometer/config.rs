@@ -625,7 +625,11 @@ impl Validate for GravelometerConfig {
             AirMode::Prescribed => {}
             AirMode::Coupled => {}
         }
+        let coupled = self.air() == AirMode::Coupled;
         c.nested("coupled_air", |c| {
+            if !coupled {
+                return;
+            }
             let a = &i.coupled_air;
             let h = a.cell_size_m.unwrap_or(f64::NAN);
             pos(c, "cell_size_m", a.cell_size_m);
