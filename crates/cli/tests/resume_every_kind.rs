@@ -414,6 +414,44 @@ output_interval_s = 0.002
 }
 
 #[test]
+fn gravelometer_with_coupled_air_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two one-sphere stones through a short pipe in solved air (k–ε, two cells across the pipe): the
+    // checkpoint carries the flow, the coupling's record and the fluid files.
+    let text = r#"kind = "gravelometer"
+standard = "din_55996_1"
+air = "coupled"
+duration_s = 0.006
+[pipe]
+length_m = 0.05
+[panel]
+width_m = 0.03
+length_m = 0.04
+distance_m = 0.05
+triangle_size_m = 0.01
+strips = 4
+[protection_box]
+margin_m = 0.02
+[stones]
+count = 2
+feed_time_s = 0.002
+youngs_modulus_pa = 1e9
+[stones.templates.ball]
+shape = { type = "ball", radius_m = 2.5e-3 }
+packing = { type = "count", sphere_count = 1 }
+[launch]
+speed_m_s = 12.0
+[coupled_air]
+cell_size_m = 0.01
+[output]
+particles_vtu = true
+output_interval_s = 0.001
+"#;
+    let s = write(dir.path(), "gravelometer_coupled.toml", text.as_bytes());
+    stop_and_resume(&s, 12, "gravelometer with coupled air");
+}
+
+#[test]
 fn integrator_study_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let text = include_str!("../../../examples/integrator_orders.toml")

@@ -27,6 +27,7 @@
 
 pub mod config;
 pub mod exchange;
+pub mod partner;
 pub mod run;
 #[cfg(test)]
 mod tests;
@@ -151,10 +152,12 @@ pub enum CouplingError {
     Dem(#[from] DemError),
 }
 
-/// A flow and a DEM simulation coupled two-way.
-pub struct Coupled<L: ContactLaw> {
+/// The fluid side of a two-way coupling: the flow, the void fraction and the exchange buffers. It
+/// couples to any DEM simulation passed to [`Coupling::exchange`]; [`Coupled`] pairs it with one, and
+/// the gravelometer's coupled air steps it inside the DEM scene's own loop
+/// ([`partner::CoupledFluid`]), so both run the same coupling step.
+pub struct Coupling {
     pub flow: Flow,
-    pub dem: Simulation<L>,
     pub options: CouplingOptions,
     void_fraction: VoidFraction,
     grad_p: [Vec<f64>; 3],
@@ -167,9 +170,28 @@ pub struct Coupled<L: ContactLaw> {
     pub last: ExchangeReport,
 }
 
-impl<L: ContactLaw> Coupled<L> {
-    /// Couples `flow` and `dem`; the DEM's gravity is the coupling's (buoyancy −ρ_f V g).
-    pub fn new(flow: Flow, dem: Simulation<L>, mut options: CouplingOptions) -> Result<Self, CouplingError> {
+/// A flow and a DEM simulation coupled two-way. Dereferences to its [`Coupling`] (`c.flow`, `c.last`).
+pub struct Coupled<L: ContactLaw> {
+    pub coupling: Coupling,
+    pub dem: Simulation<L>,
+}
+
+impl<L: ContactLaw> std::ops::Deref for Coupled<L> {
+    type Target = Coupling;
+    fn deref(&self) -> &Coupling {
+        &self.coupling
+    }
+}
+
+impl<L: ContactLaw> std::ops::DerefMut for Coupled<L> {
+    fn deref_mut(&mut self) -> &mut Coupling {
+        &mut self.coupling
+    }
+}
+
+impl Coupling {
+    /// The fluid side of a coupling on `flow`; the DEM's gravity is the coupling's (buoyancy −ρ_f V g).
+    pub fn new(flow: Flow, mut options: CouplingOptions) -> Result<Self, CouplingError> {
         if flow.grid.mode != Mode::Cartesian {
             return Err(CouplingError::NotCartesian);
         }
@@ -179,9 +201,8 @@ impl<L: ContactLaw> Coupled<L> {
             viscosity: flow.fluid.density * flow.fluid.viscosity,
         };
         let void_fraction = VoidFraction::new(&flow.grid, options.void_fraction, options.alpha_min);
-        Ok(Coupled {
+        Ok(Coupling {
             flow,
-            dem,
             options,
             void_fraction,
             grad_p: Default::default(),
@@ -198,16 +219,26 @@ impl<L: ContactLaw> Coupled<L> {
         &self.void_fraction
     }
 
-    /// The fluid time step Δt_f = N Δt_DEM \[s\].
-    pub fn fluid_dt(&self) -> f64 {
-        self.options.dem_steps_per_fluid_step as f64 * self.dem.dt
+    /// The fluid time step Δt_f = N Δt_DEM \[s\] for a DEM step `dem_dt`.
+    pub fn fluid_dt_for(&self, dem_dt: f64) -> f64 {
+        self.options.dem_steps_per_fluid_step as f64 * dem_dt
     }
 
-    /// Void fraction, forces and exchange at the current state (steps 1–3 of a coupling step), without
-    /// stepping; returns the momentum balance.
-    pub fn exchange(&mut self) -> ExchangeReport {
+    /// DEM steps of `dem_dt` the next fluid step may span: `dem_steps_per_fluid_step`, or fewer when the
+    /// flow's convective limit at Courant number `courant` or its diffusion limit (which moves with the
+    /// eddy viscosity of k–ε) is shorter; at least 1.
+    pub fn adaptive_substeps(&self, dem_dt: f64, courant: f64) -> u32 {
+        let stable = self.flow.stable_dt(courant, f64::INFINITY);
+        let n = (stable / dem_dt).floor();
+        (n.min(self.options.dem_steps_per_fluid_step as f64).max(1.0)) as u32
+    }
+
+    /// Void fraction, forces and exchange at the current state of `dem` (steps 1–3 of a coupling step),
+    /// without stepping; the forces on the spheres become `dem`'s persistent external forces. Returns
+    /// the momentum balance.
+    pub fn exchange<L: ContactLaw>(&mut self, dem: &mut Simulation<L>) -> ExchangeReport {
         let t0 = Instant::now();
-        let p = &self.dem.particles;
+        let p = &dem.particles;
         self.void_fraction.update(&self.flow.grid, &self.flow.blocked, &p.pos, &p.radius);
         let t1 = Instant::now();
         pressure_gradient_nodes(&self.flow, &mut self.grad_p);
@@ -219,7 +250,7 @@ impl<L: ContactLaw> Coupled<L> {
             GridFluid { flow: &self.flow, void_fraction: &self.void_fraction, grad_p: &self.grad_p };
         let opts = &self.options;
         let rho_f = self.flow.fluid.density;
-        let g = self.dem.gravity;
+        let g = dem.gravity;
         let t = self.flow.state.t;
         const CHUNK: usize = 1024;
         self.exchanged
@@ -271,7 +302,7 @@ impl<L: ContactLaw> Coupled<L> {
                 outside += 1;
             }
         }
-        let (ext, _) = self.dem.particles.external_force_mut();
+        let (ext, _) = dem.particles.external_force_mut();
         ext.copy_from_slice(&self.on_particles);
         let to = Vec3::from(self.flow.total_body_force());
         let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
@@ -284,6 +315,46 @@ impl<L: ContactLaw> Coupled<L> {
         self.last
     }
 
+    /// The fluid part of a coupling step spanning `substeps` DEM steps: exchange with `dem`, then one
+    /// fluid step of Δt_f = `substeps` × the DEM step (the caller then advances the DEM by as many
+    /// steps).
+    pub fn exchange_and_advance<L: ContactLaw>(
+        &mut self,
+        dem: &mut Simulation<L>,
+        substeps: u32,
+    ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
+        let dt = substeps as f64 * dem.dt;
+        // The fixed fluid step must respect the explicit diffusion limit (with k–ε it moves with ν_t).
+        // stable_dt returns 0.9 of the limit.
+        let limit = self.flow.stable_dt(f64::INFINITY, f64::INFINITY) / 0.9;
+        if dt > limit {
+            return Err(CouplingError::FluidStep { dt, limit, t: self.flow.state.t });
+        }
+        let rep = self.exchange(dem);
+        let t0 = Instant::now();
+        let frep = self.flow.step(dt)?;
+        self.times.fluid += t0.elapsed().as_secs_f64();
+        Ok((rep, frep))
+    }
+}
+
+impl<L: ContactLaw> Coupled<L> {
+    /// Couples `flow` and `dem`; the DEM's gravity is the coupling's (buoyancy −ρ_f V g).
+    pub fn new(flow: Flow, dem: Simulation<L>, options: CouplingOptions) -> Result<Self, CouplingError> {
+        Ok(Coupled { coupling: Coupling::new(flow, options)?, dem })
+    }
+
+    /// The fluid time step Δt_f = N Δt_DEM \[s\].
+    pub fn fluid_dt(&self) -> f64 {
+        self.coupling.fluid_dt_for(self.dem.dt)
+    }
+
+    /// Void fraction, forces and exchange at the current state (steps 1–3 of a coupling step), without
+    /// stepping; returns the momentum balance.
+    pub fn exchange(&mut self) -> ExchangeReport {
+        self.coupling.exchange(&mut self.dem)
+    }
+
     /// One coupling step: exchange, one fluid step of Δt_f, N DEM steps.
     pub fn step(&mut self) -> Result<ExchangeReport, CouplingError> {
         self.step_reporting().map(|(rep, _)| rep)
@@ -293,21 +364,11 @@ impl<L: ContactLaw> Coupled<L> {
     pub fn step_reporting(
         &mut self,
     ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
-        let dt = self.fluid_dt();
-        // The fixed fluid step must respect the explicit diffusion limit (with k–ε it moves with ν_t).
-        // stable_dt returns 0.9 of the limit.
-        let limit = self.flow.stable_dt(f64::INFINITY, f64::INFINITY) / 0.9;
-        if dt > limit {
-            return Err(CouplingError::FluidStep { dt, limit, t: self.flow.state.t });
-        }
-        let rep = self.exchange();
-        let t0 = Instant::now();
-        let frep = self.flow.step(dt)?;
+        let n = self.coupling.options.dem_steps_per_fluid_step;
+        let out = self.coupling.exchange_and_advance(&mut self.dem, n)?;
         let t1 = Instant::now();
-        self.dem.run_steps(self.options.dem_steps_per_fluid_step as u64)?;
-        let t2 = Instant::now();
-        self.times.fluid += (t1 - t0).as_secs_f64();
-        self.times.dem += (t2 - t1).as_secs_f64();
-        Ok((rep, frep))
+        self.dem.run_steps(self.coupling.options.dem_steps_per_fluid_step as u64)?;
+        self.coupling.times.dem += t1.elapsed().as_secs_f64();
+        Ok(out)
     }
 }

@@ -497,7 +497,7 @@ fn drive<L: ContactLaw>(
 
 /// Cell arrays of the coupling: the void fraction and the momentum source the spheres put into the
 /// fluid, ρ a at the cell centre \[N/m³\] (the average of the two face values per component).
-fn coupling_cells<L: ContactLaw>(c: &Coupled<L>) -> (Vec<f64>, Vec<[f64; 3]>) {
+pub(super) fn coupling_cells(c: &super::Coupling) -> (Vec<f64>, Vec<[f64; 3]>) {
     let flow = &c.flow;
     let l = flow.grid.layout;
     let rho = flow.fluid.density;
@@ -533,7 +533,7 @@ fn write_snapshot<L: ContactLaw>(
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(io_at(parent))?;
     }
-    let (alpha, src) = coupling_cells(c);
+    let (alpha, src) = coupling_cells(&c.coupling);
     to_vtr(&c.flow)
         .map(|v| v.cell_scalar("void_fraction", &alpha).cell_vector("momentum_source_N_m3", &src))
         .and_then(|v| v.write(&path))

@@ -12,7 +12,8 @@ pub mod setup;
 pub use config::*;
 pub(crate) use run::{inject, time_step_warnings};
 pub use run::{
-    run, run_collect, run_collect_with, simulation, with_law, MeshWallResult, SceneResults, WithLaw,
+    run, run_collect, run_collect_partnered, run_collect_with, simulation, with_law, MeshWallResult,
+    SceneResults, StepPartner, WithLaw,
 };
 
 #[cfg(test)]

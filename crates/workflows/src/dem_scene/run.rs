@@ -26,8 +26,10 @@ use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 /// Everything a resumed run needs (the checkpoint header names the input it belongs to: a resume with
 /// another scene is refused when it is loaded).
 #[derive(Serialize, Deserialize)]
-struct Checkpoint<S> {
+struct Checkpoint<S, P> {
     sim: SimState<S>,
+    /// The state of the [`StepPartner`] (nothing without one).
+    partner: P,
     /// State of each injector (particles and mass placed, pending draw, random generator).
     injectors: Vec<InjectorState>,
     output_index: u64,
@@ -116,22 +118,84 @@ pub fn run_collect_with(
     ctx: &RunContext,
     external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
 ) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    run_collect_partnered(cfg, ctx, external, NoPartner)
+}
+
+/// Something stepped in the scene's loop beside the DEM, with a state of its own that the scene's
+/// checkpoint carries: the coupled fluid of a CFD–DEM run ([`crate::cfd_dem::partner::CoupledFluid`]).
+/// The scene calls it before every DEM step (after the injection), at every output, on resume and at the
+/// end; everything else (injection, events, wear, outputs, checkpoints) stays the scene's.
+pub trait StepPartner {
+    /// What a checkpoint keeps of the partner.
+    type State: Serialize + serde::de::DeserializeOwned;
+    /// The partner's failures; a DEM failure converts into it.
+    type Error: From<DemError>;
+    /// Before DEM step `sim.step_count()`: may set the particles' persistent external forces.
+    fn before_step<L: ContactLaw>(&mut self, sim: &mut Simulation<L>) -> Result<(), Self::Error>;
+    /// At each output of the scene (after the scene's own files, at the same time).
+    fn output<L: ContactLaw>(&mut self, sim: &Simulation<L>, ctx: &RunContext) -> Result<(), Self::Error>;
+    fn state(&self) -> Self::State;
+    /// Continues from a checkpoint written at time `t` \[s\].
+    fn restore(&mut self, state: Self::State, ctx: &RunContext, t: f64) -> Result<(), Self::Error>;
+    /// After the last step: the partner's results into the summary.
+    fn finish<L: ContactLaw>(
+        &mut self,
+        sim: &Simulation<L>,
+        ctx: &RunContext,
+        summary: &mut RunSummary,
+    ) -> Result<(), Self::Error>;
+}
+
+/// No partner: the scene alone.
+pub struct NoPartner;
+
+impl StepPartner for NoPartner {
+    type State = ();
+    type Error = DemError;
+    fn before_step<L: ContactLaw>(&mut self, _: &mut Simulation<L>) -> Result<(), DemError> {
+        Ok(())
+    }
+    fn output<L: ContactLaw>(&mut self, _: &Simulation<L>, _: &RunContext) -> Result<(), DemError> {
+        Ok(())
+    }
+    fn state(&self) {}
+    fn restore(&mut self, _: (), _: &RunContext, _: f64) -> Result<(), DemError> {
+        Ok(())
+    }
+    fn finish<L: ContactLaw>(
+        &mut self,
+        _: &Simulation<L>,
+        _: &RunContext,
+        _: &mut RunSummary,
+    ) -> Result<(), DemError> {
+        Ok(())
+    }
+}
+
+/// Like [`run_collect_with`], with `partner` stepped beside the DEM (see [`StepPartner`]).
+pub fn run_collect_partnered<P: StepPartner>(
+    cfg: &SceneConfig,
+    ctx: &RunContext,
+    external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
+    partner: P,
+) -> Result<(RunSummary, Option<SceneResults>), P::Error> {
     Checker::run(cfg, None).map_err(DemError::Invalid)?;
-    with_law(cfg, SceneRun { cfg, ctx, external })
+    with_law(cfg, SceneRun { cfg, ctx, external, partner })?
 }
 
 /// The scene's own run, as a [`WithLaw`] visitor.
-struct SceneRun<'a> {
+struct SceneRun<'a, P> {
     cfg: &'a SceneConfig,
     ctx: &'a RunContext<'a>,
     external: Option<Box<dyn spatter_dem::sim::ExternalForces>>,
+    partner: P,
 }
 
-impl WithLaw for SceneRun<'_> {
-    type Output = (RunSummary, Option<SceneResults>);
+impl<P: StepPartner> WithLaw for SceneRun<'_, P> {
+    type Output = Result<(RunSummary, Option<SceneResults>), P::Error>;
     fn with<L: ContactLaw>(self, law: L, mut built: setup::Built) -> Result<Self::Output, DemError> {
         built.external = self.external;
-        run_with(law, built, self.cfg, self.ctx)
+        Ok(run_with(law, built, self.cfg, self.ctx, self.partner))
     }
 }
 
@@ -375,12 +439,13 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
     sim
 }
 
-fn run_with<L: ContactLaw>(
+fn run_with<L: ContactLaw, P: StepPartner>(
     law: L,
     built: setup::Built,
     cfg: &SceneConfig,
     ctx: &RunContext,
-) -> Result<(RunSummary, Option<SceneResults>), DemError> {
+    mut partner: P,
+) -> Result<(RunSummary, Option<SceneResults>), P::Error> {
     let mut sim = simulation(law, built, cfg);
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
@@ -413,10 +478,11 @@ fn run_with<L: ContactLaw>(
     };
     let pour_every = cfg.pour.as_ref().map_or(1, |p| ((p.interval_s / cfg.dt_s).round() as u64).max(1));
     if ctx.resume {
-        let ck: Checkpoint<L::State> = ctx.load_checkpoint()?;
+        let ck: Checkpoint<L::State, P::State> = ctx.load_checkpoint().map_err(DemError::from)?;
         sim.restore(ck.sim).map_err(DemError::Resume)?;
+        partner.restore(ck.partner, ctx, sim.time())?;
         if ck.injectors.len() != injectors.len() {
-            return Err(DemError::Resume("the number of injectors changed".into()));
+            return Err(DemError::Resume("the number of injectors changed".into()).into());
         }
         for (slot, state) in injectors.iter_mut().zip(ck.injectors) {
             slot.0.state = state;
@@ -500,6 +566,7 @@ fn run_with<L: ContactLaw>(
             index: 0,
         };
         out.write(cfg, &sim, ctx)?;
+        partner.output(&sim, ctx)?;
     }
 
     while sim.step_count() < total_steps {
@@ -508,6 +575,7 @@ fn run_with<L: ContactLaw>(
             out.flush()?;
             let ck = Checkpoint {
                 sim: sim.state(),
+                partner: partner.state(),
                 injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
                 output_index: out.index,
                 csv_bytes: out.csv.bytes_written(),
@@ -518,7 +586,7 @@ fn run_with<L: ContactLaw>(
                 warnings: warnings.clone(),
                 pour: pour.clone(),
             };
-            ctx.save_checkpoint(&ck)?;
+            ctx.save_checkpoint(&ck).map_err(DemError::from)?;
             write_events(cfg, &sim, &events, ctx)?;
         }
         if stop {
@@ -544,6 +612,7 @@ fn run_with<L: ContactLaw>(
         if (step + 1) % out_every == 0 || step + 1 == total_steps {
             sim.request_energy();
         }
+        partner.before_step(&mut sim)?;
         sim.step()?;
         if let Some(e) = &cfg.output.events {
             events.after_step(&sim, e);
@@ -557,6 +626,7 @@ fn run_with<L: ContactLaw>(
         }
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {
             out.write(cfg, &sim, ctx)?;
+            partner.output(&sim, ctx)?;
             // A pour is checked for rest at the outputs, so that a run ending early ends on one.
             if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
                 if state.settled_s.is_none() && super::pour::settled(&sim, p, state) {
@@ -594,6 +664,7 @@ fn run_with<L: ContactLaw>(
         s.artifacts.push((format!("eroded mass per triangle {name} (VTU)"), record.vtu.clone()));
         s.maps.push(record);
     }
+    partner.finish(&sim, ctx, &mut s)?;
     let r = results(&sim, events);
     Ok((s, Some(r)))
 }

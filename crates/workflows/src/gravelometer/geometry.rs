@@ -196,29 +196,44 @@ pub fn clamp(d: &Dimensions) -> TriMesh {
     let mut s = Vec::new();
     let (hw, hl) = (0.5 * f.width, 0.5 * f.length);
     for (lo, hi) in [(hl - d.clamp_bar_width, hl), (-hl, -hl + d.clamp_bar_width)] {
-        // Corners in (across, up, normal) coordinates.
-        let p = |a: f64, s: f64, n: f64| f.center + a * f.across + s * f.up + n * f.normal;
-        let t = d.clamp_thickness;
-        let c = [
-            p(-hw, lo, 0.0),
-            p(hw, lo, 0.0),
-            p(hw, hi, 0.0),
-            p(-hw, hi, 0.0),
-            p(-hw, lo, t),
-            p(hw, lo, t),
-            p(hw, hi, t),
-            p(-hw, hi, t),
-        ];
-        // Outward faces of the box (the stones hit it from outside); (across, up, normal) is left-handed,
-        // so counter-clockwise seen from outside runs the corners in this order.
-        quad(&mut s, c[4], c[7], c[6], c[5]);
-        quad(&mut s, c[0], c[1], c[2], c[3]);
-        quad(&mut s, c[0], c[4], c[5], c[1]);
-        quad(&mut s, c[2], c[6], c[7], c[3]);
-        quad(&mut s, c[1], c[5], c[6], c[2]);
-        quad(&mut s, c[0], c[3], c[7], c[4]);
+        panel_cuboid(&mut s, &f, (-hw, hw), (lo, hi), (0.0, d.clamp_thickness));
     }
     TriMesh::from_triangle_soup(&s)
+}
+
+/// The panel as a closed slab for the flow solver's blocked cells: its front face is the panel, its
+/// back `thickness` behind it (a slab thinner than a flow cell could slip between the cell centres).
+pub fn panel_slab(d: &Dimensions, thickness: f64) -> TriMesh {
+    let f = PanelFrame::new(d);
+    let mut s = Vec::new();
+    let (hw, hl) = (0.5 * f.width, 0.5 * f.length);
+    panel_cuboid(&mut s, &f, (-hw, hw), (-hl, hl), (-thickness, 0.0));
+    TriMesh::from_triangle_soup(&s)
+}
+
+/// Appends the triangles of the closed box spanning `across`, `up` and `normal` (ranges in the panel
+/// frame) to `s`, faces outwards.
+fn panel_cuboid(s: &mut Vec<Vec3>, f: &PanelFrame, across: (f64, f64), up: (f64, f64), normal: (f64, f64)) {
+    let p = |a: f64, u: f64, n: f64| f.center + a * f.across + u * f.up + n * f.normal;
+    let ((a0, a1), (u0, u1), (n0, n1)) = (across, up, normal);
+    let c = [
+        p(a0, u0, n0),
+        p(a1, u0, n0),
+        p(a1, u1, n0),
+        p(a0, u1, n0),
+        p(a0, u0, n1),
+        p(a1, u0, n1),
+        p(a1, u1, n1),
+        p(a0, u1, n1),
+    ];
+    // (across, up, normal) is left-handed, so counter-clockwise seen from outside runs the corners in
+    // this order.
+    quad(s, c[4], c[7], c[6], c[5]);
+    quad(s, c[0], c[1], c[2], c[3]);
+    quad(s, c[0], c[4], c[5], c[1]);
+    quad(s, c[2], c[6], c[7], c[3]);
+    quad(s, c[1], c[5], c[6], c[2]);
+    quad(s, c[0], c[3], c[7], c[4]);
 }
 
 #[cfg(test)]

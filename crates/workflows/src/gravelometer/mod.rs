@@ -11,6 +11,7 @@
 
 pub mod air;
 pub mod config;
+pub mod coupled;
 pub mod geometry;
 mod results;
 pub mod scene;
@@ -34,6 +35,9 @@ pub enum GravelometerError {
     Dem(#[from] DemError),
     #[error("{path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    /// The coupled air failed (a fluid step beyond its stability limit, a fluid file).
+    #[error(transparent)]
+    Coupled(#[from] crate::cfd_dem::partner::PartnerError),
 }
 
 /// Runs the scenario in `ctx`: the DEM scene's files plus the gravelometer results (see
@@ -67,7 +71,32 @@ pub fn run(cfg: &GravelometerConfig, ctx: &RunContext) -> Result<RunSummary, Gra
             a.outside
         );
     }
-    let (mut summary, results) = crate::dem_scene::run_collect_with(&scfg, ctx, hook)?;
+    let (mut summary, results) = if cfg.air() == AirMode::Coupled {
+        let dom = coupled::domain(cfg, &plan, &geo)?;
+        let fluid = coupled::coupled_fluid(cfg, &dom)?;
+        let x = &dom.grid.x;
+        let (y, z) = (&dom.grid.y, dom.grid.z_axis());
+        tracing::info!(
+            "coupled air: grid {} × {} × {} cells of {} m over x [{}, {}] m, y [{}, {}] m, z [{}, {}] m; \
+             turbulence {:?}; {} DEM steps per fluid step (Δt_f = {:.3e} s)",
+            x.cells,
+            y.cells,
+            z.cells,
+            config::get(cfg.input.coupled_air.cell_size_m),
+            x.min_m,
+            x.max_m,
+            y.min_m,
+            y.max_m,
+            z.min_m,
+            z.max_m,
+            dom.turbulence,
+            dom.substeps,
+            dom.substeps as f64 * plan.dt
+        );
+        crate::dem_scene::run_collect_partnered(&scfg, ctx, None, fluid)?
+    } else {
+        crate::dem_scene::run_collect_with(&scfg, ctx, hook)?
+    };
     let Some(r) = results else { return Ok(summary) };
     if summary.finished != Finished::Completed {
         return Ok(summary);

@@ -71,6 +71,9 @@ pub struct Plan {
     pub stone_radius: f64,
     /// The prescribed air field (`air = "prescribed"`), else `None`.
     pub air: Option<PipeAir>,
+    /// The fastest the air is expected to blow \[m/s\]: the prescribed centreline speed, 1.3 × the
+    /// bulk speed with coupled air (a developed pipe profile peaks at 1.22 U_b), 0 without air.
+    pub air_speed: f64,
 }
 
 fn config_error(key: &str, message: String) -> GravelometerError {
@@ -216,7 +219,7 @@ pub fn plan(cfg: &GravelometerConfig) -> Result<Plan, GravelometerError> {
     let flux = kg_per_s / density;
     // The stones move at least at their launch speed; prescribed air drags them to the air's speed.
     let carrier = match cfg.air() {
-        AirMode::Prescribed => vh.max(get(i.pipe.air_velocity_m_s)),
+        AirMode::Prescribed | AirMode::Coupled => vh.max(get(i.pipe.air_velocity_m_s)),
         _ => vh,
     };
     let capacity = MAX_PIPE_LOADING * area * carrier;
@@ -243,9 +246,14 @@ pub fn plan(cfg: &GravelometerConfig) -> Result<Plan, GravelometerError> {
             outside: get(a.outside),
         }
     });
+    let air_speed = match cfg.air() {
+        AirMode::None => 0.0,
+        AirMode::Prescribed => air.as_ref().map_or(0.0, PipeAir::centreline),
+        AirMode::Coupled => 1.3 * get(i.pipe.air_velocity_m_s),
+    };
     let dt = match i.dt_s {
         Some(dt) => dt,
-        None => auto_dt(cfg, &stones, top_speed(launch, air.as_ref())),
+        None => auto_dt(cfg, &stones, top_speed(launch, air_speed)),
     };
     let frame = PanelFrame::new(&dims);
     Ok(Plan {
@@ -261,6 +269,7 @@ pub fn plan(cfg: &GravelometerConfig) -> Result<Plan, GravelometerError> {
         feed_time,
         stone_radius,
         air,
+        air_speed,
     })
 }
 
@@ -283,10 +292,10 @@ pub fn air_forces(
     Some(Box::new(FluidForces::new(sampler, options)))
 }
 
-/// The fastest a stone is expected to fly \[m/s\]: its launch speed, or the air's centreline speed
-/// when prescribed air is faster.
-pub fn top_speed(launch: Vec3, air: Option<&PipeAir>) -> f64 {
-    launch.length().max(air.map_or(0.0, |a| a.centreline()))
+/// The fastest a stone is expected to fly \[m/s\]: its launch speed, or the air's top speed
+/// `air_speed` when that is faster.
+pub fn top_speed(launch: Vec3, air_speed: f64) -> f64 {
+    launch.length().max(air_speed)
 }
 
 fn stone_material(cfg: &GravelometerConfig) -> Material {
@@ -406,7 +415,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         engine: EngineConfig {
             domain_min_m: Some(pipe_min.min(box_bounds.min) - margin),
             domain_max_m: Some(box_bounds.max + margin),
-            impact_speed_m_s: Some(1.5 * top_speed(plan.launch, plan.air.as_ref()).max(1.0)),
+            impact_speed_m_s: Some(1.5 * top_speed(plan.launch, plan.air_speed).max(1.0)),
             ..Default::default()
         },
         materials,

@@ -82,9 +82,15 @@ fn bad_values_are_refused_with_the_key_and_the_expected_form() {
     assert!(problems("standard = \"din_55996_1\"\n[panel]\nangle_deg = 90.0").is_empty());
     let p = problems("standard = \"sae_j400\"\n[panel]\ntriangle_size_m = 0.1\nstrips = 8");
     assert!(p.contains("panel.strips") && p.contains("more than the 3 rows"), "{p}");
-    let p = problems("standard = \"sae_j400\"\nair = \"coupled\"");
-    assert!(p.contains("air") && p.contains("coupling"), "{p}");
-    assert!(p.contains("cfd_dem"), "{p}");
+    assert!(problems("standard = \"sae_j400\"\nair = \"coupled\"").is_empty());
+    let coupled =
+        |keys: &str| problems(&format!("standard = \"sae_j400\"\nair = \"coupled\"\n[coupled_air]\n{keys}"));
+    let p = coupled("cell_size_m = 0.03");
+    assert!(p.contains("coupled_air.cell_size_m") && p.contains("fewer than two cells"), "{p}");
+    let p = coupled("turbulence = \"k_epsilon\"");
+    assert!(p.contains("coupled_air.turbulence") && p.contains("blocked"), "{p}");
+    assert!(coupled("inlet_intensity = 0.0").contains("coupled_air.inlet_intensity"));
+    assert!(coupled("dem_steps_per_fluid_step = 0").contains("coupled_air.dem_steps_per_fluid_step"));
     assert!(problems("standard = \"sae_j400\"\nair = \"prescribed\"").is_empty());
     let air = |keys: &str| {
         problems(&format!("standard = \"din_55996_1\"\nair = \"prescribed\"\n[air_field]\n{keys}"))
@@ -407,4 +413,160 @@ output_interval_s = 0.01
         }
         last = Some((v, hits));
     }
+}
+
+/// A small DIN set-up for the coupled air: a `pipe_m` pipe, a 30 × 40 mm panel 50 mm from the exit
+/// in a box 20 mm larger all round (a few thousand flow cells), a 5 mm steel ball from rest.
+fn coupled_case(air: &str, pipe_m: f64, bulk: f64, cell: f64, duration: f64) -> String {
+    format!(
+        r#"standard = "din_55996_1"
+air = "{air}"
+duration_s = {duration}
+[pipe]
+length_m = {pipe_m}
+air_velocity_m_s = {bulk}
+[panel]
+width_m = 0.03
+length_m = 0.04
+distance_m = 0.05
+triangle_size_m = 0.01
+strips = 4
+[protection_box]
+margin_m = 0.02
+[stones]
+shape = "sphere"
+sphere_diameter_m = 0.005
+member_diameter_m = 0.005
+density_kg_m3 = 7850.0
+youngs_modulus_pa = 1e9
+count = 1
+feed_time_s = 0.001
+[launch]
+speed_m_s = 0.0
+fall_height_m = 0.0
+[air_field]
+ramp_s = 0.005
+[coupled_air]
+cell_size_m = {cell}
+[output]
+particles_vtu = false
+output_interval_s = 0.005
+"#
+    )
+}
+
+/// The air of the coupled pipe alone (no stones), stepped to `t_end`: (flow, domain).
+fn empty_pipe(text: &str, t_end: f64) -> (spatter_cfd::Flow, super::coupled::AirDomain) {
+    let cfg = load(text);
+    Checker::run(&cfg, None).unwrap();
+    let p = plan(&cfg).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    super::scene::write_geometry(&p, tmp.path()).unwrap();
+    let dom = super::coupled::domain(&cfg, &p, tmp.path()).unwrap();
+    let mut fluid = super::coupled::coupled_fluid(&cfg, &dom).unwrap();
+    while fluid.coupling.flow.state.t < t_end {
+        let n = fluid.coupling.adaptive_substeps(p.dt, crate::cfd_dem::partner::FLUID_COURANT);
+        fluid.coupling.flow.step(n as f64 * p.dt).unwrap();
+    }
+    (fluid.coupling.flow, dom)
+}
+
+/// Axial velocity of the cells of the pipe section nearest `x`: (r, u) per open cell.
+fn section(flow: &spatter_cfd::Flow, x: f64) -> Vec<(f64, f64)> {
+    let g = &flow.grid;
+    let l = g.layout;
+    let i = (0..l.n[0])
+        .min_by(|&a, &b| (g.axes[0].centre(a) - x).abs().total_cmp(&(g.axes[0].centre(b) - x).abs()));
+    let i = i.unwrap();
+    let mut out = Vec::new();
+    for k in 0..l.n[2] {
+        for j in 0..l.n[1] {
+            if !flow.blocked[l.cell(i, j, k)] {
+                let (y, z) = (g.axes[1].centre(j), g.axes[2].centre(k));
+                out.push(((y * y + z * z).sqrt(), flow.cell_velocity(i, j, k)[0]));
+            }
+        }
+    }
+    out
+}
+
+/// The empty coupled DIN pipe (30 mm, 28 m/s bulk, laminar, the preset's 7.5 mm cells) after the
+/// inlet ramp: every section carries the inlet's bulk speed (continuity through the stair-stepped
+/// bore, to 1e-9 relative), the no-slip pipe wall slows the wall cells below the middle ones, and the
+/// pressure falls along the pipe (friction) and is finite everywhere. The comparison of the developed
+/// profile with the turbulent power law and of the friction with Blasius needs k–ε with wall functions
+/// on the faces of blocked cells, which the flow solver does not have yet (`docs/gravelometer.md`).
+#[test]
+fn the_empty_coupled_pipe_carries_the_bulk_speed_through_every_section() {
+    let text = coupled_case("coupled", 0.29, 28.0, 0.0075, 0.05);
+    let (flow, dom) = empty_pipe(&text, 0.02);
+    assert!(dom.grid.x.min_m <= -0.29 && dom.grid.x.min_m > -0.29 - 0.0075, "{:?}", dom.grid.x);
+    let ub = 28.0;
+    for x in [-0.25, -0.15, -0.05] {
+        let s = section(&flow, x);
+        // Open cells: those with centres in the bore, 12 of the 4 × 4 around the axis.
+        assert_eq!(s.len(), 12, "x = {x}");
+        let mean = s.iter().map(|c| c.1).sum::<f64>() / s.len() as f64;
+        assert!((mean / ub - 1.0).abs() < 1e-9, "x = {x}: bulk {mean} m/s on {} cells", s.len());
+    }
+    let s = section(&flow, -0.05);
+    let r_mid = 0.5 * 0.015;
+    let mean_of = |inner: bool| {
+        let v: Vec<f64> = s.iter().filter(|c| (c.0 < r_mid) == inner).map(|c| c.1).collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let (centre, wall) = (mean_of(true), mean_of(false));
+    assert!(centre > wall, "centre {centre} m/s, wall cells {wall} m/s");
+    let g = &flow.grid;
+    let p_at = |x: f64| {
+        let l = g.layout;
+        let i = (0..l.n[0])
+            .min_by(|&a, &b| (g.axes[0].centre(a) - x).abs().total_cmp(&(g.axes[0].centre(b) - x).abs()))
+            .unwrap();
+        let (mut sum, mut n) = (0.0, 0.0);
+        for k in 0..l.n[2] {
+            for j in 0..l.n[1] {
+                if !flow.blocked[l.cell(i, j, k)] {
+                    sum += flow.cell_pressure(i, j, k);
+                    n += 1.0;
+                }
+            }
+        }
+        sum / n
+    };
+    let (pa, pb) = (p_at(-0.25), p_at(-0.05));
+    assert!(pa.is_finite() && pb.is_finite() && pa > pb, "p {pa} Pa at x = -0.25 m, {pb} Pa at -0.05 m");
+}
+
+/// One 5 mm steel ball launched at 8 m/s along the axis of the coupled 0.29 m DIN pipe (28 m/s bulk)
+/// gains speed from the air as in the prescribed power-law air of the same bulk speed. The gain is
+/// drag × time: with Newton drag (C_D ≈ 0.44) at a slip near 28 m/s the ball speeds up at about
+/// 8 m/s² over its 36 ms in the pipe, +0.3 m/s. What differs: the prescribed air on the axis is the
+/// developed power law's 1.224 U_b, the coupled (laminar, four cells across) air about U_b, read by
+/// the drag as U/α with the ball's own void fraction α ≈ 0.85 in its 7.5 mm cell — the slips differ by
+/// about 10 %, which enters the drag squared: the gains are asked to agree within 25 %. The ball
+/// flies 0.3 mm lower by the exit and never touches the wall. The coupling's momentum balance closes to
+/// round-off at every step (relative mismatch below 1e-12).
+#[test]
+fn one_ball_in_the_coupled_pipe_leaves_it_as_fast_as_in_prescribed_air() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run_air = |air: &str| {
+        let text = coupled_case(air, 0.29, 28.0, 0.0075, 0.045).replace("speed_m_s = 0.0", "speed_m_s = 8.0");
+        let s = run_in(&tmp.path().join(air), &text);
+        (scalar(&s, "first_stone_exit_speed_m_s") - 8.0, s)
+    };
+    let (gp, sp) = run_air("prescribed");
+    let (gc, s) = run_air("coupled");
+    eprintln!("speed gained in the pipe: prescribed {gp} m/s, coupled {gc} m/s");
+    assert!(gp > 0.15 && gp < 0.6, "prescribed gain {gp} m/s (Newton-drag estimate +0.3 m/s)");
+    assert!((gc / gp - 1.0).abs() < 0.25, "gain {gc} m/s coupled, {gp} m/s prescribed");
+    for r in [&sp, &s] {
+        assert_eq!(scalar(r, "first_stone_pipe_collisions"), 0.0);
+    }
+    let mismatch = scalar(&s, "max_momentum_mismatch");
+    assert!(mismatch < 1e-12, "momentum mismatch {mismatch}");
+    assert!(scalar(&s, "coupling_steps") > 10.0);
+    assert!(
+        tmp.path().join("coupled/fields.pvd").exists() && tmp.path().join("coupled/coupling.csv").exists()
+    );
 }
