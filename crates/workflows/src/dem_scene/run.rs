@@ -524,7 +524,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         events = ck.events;
         warnings = ck.warnings;
         if pour.is_some() != ck.pour.is_some() {
-            return Err(DemError::Resume("the [pour] table was added or removed".into()));
+            return Err(DemError::Resume("the [pour] table was added or removed".into()).into());
         }
         pour = ck.pour;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
