@@ -135,6 +135,36 @@ pub struct CouplingTimes {
     pub dem: f64,
 }
 
+impl CouplingTimes {
+    /// What a coupled run reports of its cost after `coupling_steps` steps that took `pressure_iterations`
+    /// pressure iterations in all: the headline "time per coupling step [ms]: …" and the per-step scalars
+    /// (pressure iterations, then seconds of fluid, void fraction, forces and DEM).
+    pub fn cost_report(
+        &self,
+        coupling_steps: u64,
+        pressure_iterations: u64,
+    ) -> (String, [(&'static str, f64); 5]) {
+        let steps = coupling_steps.max(1) as f64;
+        let per = |v: f64| 1e3 * v / steps;
+        let line = format!(
+            "time per coupling step [ms]: fluid {:.3}, void fraction {:.3}, forces {:.3}, DEM {:.3} (total {:.3})",
+            per(self.fluid),
+            per(self.void_fraction),
+            per(self.forces),
+            per(self.dem),
+            per(self.fluid + self.void_fraction + self.forces + self.dem)
+        );
+        let scalars = [
+            ("pressure_iterations_per_step", pressure_iterations as f64 / steps),
+            ("time_fluid_s_per_step", self.fluid / steps),
+            ("time_void_fraction_s_per_step", self.void_fraction / steps),
+            ("time_forces_s_per_step", self.forces / steps),
+            ("time_dem_s_per_step", self.dem / steps),
+        ];
+        (line, scalars)
+    }
+}
+
 /// Why a coupled step failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CouplingError {

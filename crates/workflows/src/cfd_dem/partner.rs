@@ -243,9 +243,7 @@ impl StepPartner for CoupledFluid {
             csv.flush().map_err(io_at(&p))?;
         }
         let st = &self.st;
-        let tm = st.times;
-        let steps = st.coupling_steps.max(1) as f64;
-        let per = |v: f64| 1e3 * v / steps;
+        let (cost_line, cost_scalars) = st.times.cost_report(st.coupling_steps, st.pressure_iterations);
         s.headline.push(format!(
             "coupled air: {} coupling steps (at most {} DEM steps each, at fewest {}); momentum balance of the \
              exchange: largest relative mismatch {:.2e}; largest Courant number {:.3}",
@@ -255,24 +253,13 @@ impl StepPartner for CoupledFluid {
             st.max_mismatch,
             st.max_courant
         ));
-        s.headline.push(format!(
-            "time per coupling step [ms]: fluid {:.3}, void fraction {:.3}, forces {:.3}, DEM {:.3} (total {:.3})",
-            per(tm.fluid),
-            per(tm.void_fraction),
-            per(tm.forces),
-            per(tm.dem),
-            per(tm.fluid + tm.void_fraction + tm.forces + tm.dem)
-        ));
-        for (name, v) in [
+        s.headline.push(cost_line);
+        let counts = [
             ("coupling_steps", st.coupling_steps as f64),
             ("max_momentum_mismatch", st.max_mismatch),
             ("max_courant", st.max_courant),
-            ("pressure_iterations_per_step", st.pressure_iterations as f64 / steps),
-            ("time_fluid_s_per_step", tm.fluid / steps),
-            ("time_void_fraction_s_per_step", tm.void_fraction / steps),
-            ("time_forces_s_per_step", tm.forces / steps),
-            ("time_dem_s_per_step", tm.dem / steps),
-        ] {
+        ];
+        for (name, v) in counts.into_iter().chain(cost_scalars) {
             s.scalar(name, v);
         }
         s.artifacts.push(("fluid fields (ParaView)".into(), ctx.dir.path("fields.pvd")));

@@ -613,9 +613,7 @@ fn finish<L: ContactLaw>(
     let dp = pressure_drop(flow, c.dem.gravity);
     let h = bed_height(&c.dem, flow);
     let (pm, ke) = particle_momentum(&c.dem);
-    let tm = st.times;
-    let total = tm.fluid + tm.void_fraction + tm.forces + tm.dem;
-    let per = |v: f64| 1e3 * v / (st.coupling_steps.max(1) as f64);
+    let (cost_line, cost_scalars) = st.times.cost_report(st.coupling_steps, st.pressure_iterations);
     s.headline.push(format!(
         "t = {:.6} s after {} coupling steps ({} DEM steps each); {} spheres; pressure drop {dp:.4e} Pa; \
          bed height {h:.4e} m; {wall:.1} s wall time",
@@ -628,20 +626,12 @@ fn finish<L: ContactLaw>(
         "momentum balance of the exchange: largest relative mismatch {:.2e} over all coupling steps",
         st.max_mismatch
     ));
-    s.headline.push(format!(
-        "time per coupling step [ms]: fluid {:.3}, void fraction {:.3}, forces {:.3}, DEM {:.3} (total {:.3})",
-        per(tm.fluid),
-        per(tm.void_fraction),
-        per(tm.forces),
-        per(tm.dem),
-        per(total)
-    ));
+    s.headline.push(cost_line);
     tracing::info!("{}", s.headline[2]);
     for w in &st.warnings {
         s.headline.push(format!("warning: {w}"));
     }
-    let steps = st.coupling_steps.max(1) as f64;
-    for (name, v) in [
+    let results = [
         ("t_end_s", flow.state.t),
         ("coupling_steps", st.coupling_steps as f64),
         ("particles", c.dem.particles.len() as f64),
@@ -652,12 +642,8 @@ fn finish<L: ContactLaw>(
         ("max_momentum_mismatch", st.max_mismatch),
         ("alpha_min", c.last.alpha_min),
         ("max_courant", st.max_courant),
-        ("pressure_iterations_per_step", st.pressure_iterations as f64 / steps),
-        ("time_fluid_s_per_step", tm.fluid / steps),
-        ("time_void_fraction_s_per_step", tm.void_fraction / steps),
-        ("time_forces_s_per_step", tm.forces / steps),
-        ("time_dem_s_per_step", tm.dem / steps),
-    ] {
+    ];
+    for (name, v) in results.into_iter().chain(cost_scalars) {
         s.scalar(name, v);
     }
     for p in &cfg.output.probes {
