@@ -453,18 +453,8 @@ impl Turbulence {
             if !l.interior(q) || blocked[c] {
                 return (k[c], e[c]);
             }
-            // Strain rate 2 S_ij S_ij from the cell-centred velocities.
-            let mut g = [[0.0; 3]; 3];
-            for a in 0..dims {
-                g[a][a] = (u[a][c] - u[a][c - s[a]]) / m[a].d[q[a]];
-                for b in 0..dims {
-                    if b != a {
-                        let sb = s[b];
-                        let span = m[b].xc[q[b] + 1] - m[b].xc[q[b] - 1];
-                        g[a][b] = (uc(c + sb, a) - uc(c - sb, a)) / span;
-                    }
-                }
-            }
+            // Strain rate 2 S_ij S_ij from the cell-centred velocities (the hoop strain is added below).
+            let g = cell_gradient(grid, u, c, false);
             let mut s2 = 0.0;
             for a in 0..3 {
                 for b in 0..3 {
