@@ -514,3 +514,58 @@ impl Simulation {
         (count[0] > 0).then(|| sum[0] / count[0] as f64)
     }
 }
+
+/// Wetting on several ranks: each wall particle's wet flag is kept by the rank whose box holds it, and its
+/// wet time is split over the ranks that owned it while it was wet (each step's dt goes to one rank).
+impl Simulation {
+    /// True when wall particle `i` lies in this rank's box now (always on one rank).
+    fn owns_wall(&self, i: usize) -> bool {
+        self.decomp.as_ref().is_none_or(|d| d.owns(self.boundary.position(i)))
+    }
+
+    /// [`crate::wetting::wet_area`] over all ranks (collective).
+    pub fn wet_area_with(&self, comm: &dyn Comm, k: usize, elapsed: f64) -> crate::wetting::WetArea {
+        let mut w = crate::wetting::wet_area(self, k, elapsed);
+        if self.decomp.is_none() {
+            return w;
+        }
+        let part = &self.boundary.parts[k];
+        let b = &self.boundary;
+        // The mean is a sum over every particle's partial wet time; "wet now" counts owned particles.
+        let now: f64 =
+            (part.start..part.end).filter(|&i| b.wet[i] && self.owns_wall(i)).map(|i| b.area[i]).sum();
+        let mut v = [now, w.wet_mean];
+        comm.sum_f64_ordered(&mut v);
+        (w.wet_now, w.wet_mean) = (v[0], v[1]);
+        w
+    }
+
+    /// The wet flag and total wet time \[s\] of every wall particle, gathered from the ranks that hold
+    /// them (collective); on one rank the boundary's own arrays.
+    pub fn wetting_with(&self, comm: &dyn Comm) -> (Vec<bool>, Vec<f64>) {
+        let b = &self.boundary;
+        if self.decomp.is_none() {
+            return (b.wet.clone(), b.wet_time.clone());
+        }
+        let mut wet: Vec<u64> = (0..b.len()).map(|i| u64::from(b.wet[i] && self.owns_wall(i))).collect();
+        comm.all_sum_u64(&mut wet);
+        let mut time = b.wet_time.clone();
+        comm.sum_f64_ordered(&mut time);
+        (wet.iter().map(|&w| w > 0).collect(), time)
+    }
+
+    /// Gathers the wetting records ([`Self::wetting_with`]): afterwards every rank holds every wall
+    /// particle's current wet flag, rank 0 the whole wet time and the others none, so the maps drawn from
+    /// the boundary on rank 0 are the run's, and the collective sums stay right if the run steps on.
+    pub fn gather_wetting(&mut self, comm: &dyn Comm) {
+        if self.decomp.is_none() {
+            return;
+        }
+        let (wet, mut time) = self.wetting_with(comm);
+        if comm.rank() != 0 {
+            time.fill(0.0);
+        }
+        self.boundary.wet = wet;
+        self.boundary.wet_time = time;
+    }
+}
