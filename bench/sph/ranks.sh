@@ -7,7 +7,8 @@
 #   END=0.05 REPEAT=3 bench/sph/ranks.sh
 #
 # Needs OpenMPI (libopenmpi-dev, openmpi-bin) and libclang-dev; builds `spatter` in release with the `mpi`
-# feature. Measure on a quiet machine: the load average is printed before and after.
+# feature, or uses SPATTER=path/to/spatter (built with the feature) as given. Measure on a quiet machine:
+# the load average is printed before and after.
 set -euo pipefail
 export LC_ALL=C
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -16,8 +17,12 @@ cd "$root"
 end="${END:-0.02}"
 repeat="${REPEAT:-2}"
 target="${CARGO_TARGET_DIR:-target}"
-cargo build --release -p spatter-cli --features mpi --locked
-exe="$target/release/spatter"
+if [ -n "${SPATTER:-}" ]; then
+    exe="$SPATTER"
+else
+    cargo build --release -p spatter-cli --features mpi --locked
+    exe="$target/release/spatter"
+fi
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # The example with a shorter end time and no particle output beyond the first.
