@@ -67,6 +67,9 @@ pub struct SceneConfig {
     /// Start from the spheres of a bed file (see `docs/bed.md`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bed: Option<BedStart>,
+    /// A probe driven into the bed (see `docs/bed.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<ProbeConfig>,
     #[serde(default)]
     pub output: OutputConfig,
 }
@@ -436,6 +439,7 @@ fn one() -> f64 {
 }
 
 pub use super::pour::PourConfig;
+pub use super::probe::{ProbeConfig, ProbeShape};
 pub use crate::motions::{MotionConfig, MotionType};
 
 /// A region for fills and injections (`type = "box" | "cylinder" | "mesh"`).
@@ -1017,6 +1021,9 @@ impl Validate for SceneConfig {
         });
         if let Some(p) = &self.pour {
             super::pour::check(c, self, p);
+        }
+        if let Some(p) = &self.probe {
+            super::probe::check(c, self, p);
         }
         if let Some(b) = &self.bed {
             c.nested("bed", |c| {

@@ -6,6 +6,7 @@ mod clumps;
 mod config;
 pub mod events;
 pub mod pour;
+pub mod probe;
 mod run;
 pub mod setup;
 
