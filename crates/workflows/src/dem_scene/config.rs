@@ -1127,7 +1127,7 @@ impl Validate for SceneConfig {
 impl spatter_io::run::Smoke for SceneConfig {
     /// 40 steps, an output at the start, half-way and the end; fills of a counted size keep at most 200
     /// particles (lattice and fraction fills keep their region: they are set up, not stepped, in bulk), a
-    /// pour at most 50.
+    /// pour at most 50, a probe's largest depth what half the run can reach.
     fn smoke(&mut self) {
         self.duration_s = self.duration_s.min(40.0 * self.dt_s);
         self.output_interval_s = self.output_interval_s.min(20.0 * self.dt_s);
@@ -1138,6 +1138,13 @@ impl spatter_io::run::Smoke for SceneConfig {
         }
         if let Some(p) = &mut self.pour {
             p.count = p.count.min(50);
+        }
+        // A probe goes as deep as half the shortened run allows (it usually stays above the bed).
+        if let Some(p) = &mut self.probe {
+            p.max_depth_m = p.max_depth_m.min(0.5 * self.duration_s * p.speed_m_s);
+            if let Some(d) = &mut p.immersion_depth_m {
+                *d = d.min(0.5 * p.max_depth_m);
+            }
         }
     }
 }

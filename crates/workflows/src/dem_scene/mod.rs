@@ -20,4 +20,6 @@ pub use run::{
 #[cfg(test)]
 mod pour_tests;
 #[cfg(test)]
+mod probe_tests;
+#[cfg(test)]
 mod tests;

@@ -215,6 +215,8 @@ pub struct ProbeState {
     pub w_p: f64,
     /// Samples so far: (t \[s\], depth \[m\], force \[N\]).
     pub samples: Vec<(f64, f64, f64)>,
+    /// Depth after the latest step \[m\].
+    pub depth_now: f64,
 }
 
 impl ProbeState {
@@ -303,6 +305,7 @@ pub(crate) fn start<L: ContactLaw>(p: &ProbeConfig, sim: &Simulation<L>) -> Resu
         d_p,
         w_p: w_sum / n as f64,
         samples: Vec::with_capacity((travel / p.speed_m_s * p.sample_hz).ceil().min(1e7) as usize + 1),
+        depth_now: lead0 - surface,
     })
     .inspect(|s| {
         tracing::info!(
@@ -326,10 +329,11 @@ pub(crate) fn after_step<L: ContactLaw>(
     s: &mut ProbeState,
     every: u64,
 ) {
+    let t = sim.time();
+    s.depth_now = s.depth(p.speed_m_s, t);
     if sim.step_count() % every == 0 {
-        let t = sim.time();
         let force = -sim.wall_force(s.wall).dot(s.dir);
-        s.samples.push((t, s.depth(p.speed_m_s, t), force));
+        s.samples.push((t, s.depth_now, force));
     }
 }
 
@@ -359,7 +363,7 @@ pub(crate) fn finish(
     }
     std::fs::write(&path, text).map_err(io(&path))?;
     s.artifacts.push(("probe force against depth".into(), path));
-    let reached = state.samples.last().map_or(0.0, |x| x.1);
+    let reached = state.depth_now;
     s.scalar("probe_samples", state.samples.len() as f64);
     s.scalar("probe_depth_m", reached);
     s.scalar("probe_max_force_N", force.iter().copied().fold(0.0, f64::max));

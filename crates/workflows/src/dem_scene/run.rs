@@ -537,7 +537,10 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         probe = ck.probe;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
-        let initial = setup::initial_particles(cfg, &sim.walls, sim.templates())?;
+        // The fills do not avoid the probe (the last wall): a probe placed in the bed is an error, not a
+        // hole in it.
+        let container = sim.walls.len() - usize::from(cfg.probe.is_some());
+        let initial = setup::initial_particles(cfg, &sim.walls[..container], sim.templates())?;
         for p in initial.spheres {
             sim.add_particle(p);
         }
