@@ -16,7 +16,7 @@
 use crate::contact::{HertzMindlin, PairTable};
 use crate::error::DemError;
 use crate::particles::NewParticle;
-use crate::sim::{uniform_pairs, Settings, SimState, Simulation};
+use crate::sim::{uniform_pairs, Integrator, Settings, SimState, Simulation};
 use crate::walls::{Plane, Wall, WallShape};
 use spatter_core::material::Material;
 use spatter_core::motion::Motion;
@@ -217,6 +217,7 @@ pub fn time_clump_run(
         .build()
         .map_err(|e| DemError::Config { key: "threads".into(), message: e.to_string() })?;
     let r0 = sim.rebuild_count();
+    let e0 = sim.force_evaluations();
     let t = Instant::now();
     pool.install(|| {
         sim.run_steps(steps.saturating_sub(1))?;
@@ -224,7 +225,14 @@ pub fn time_clump_run(
         sim.run_steps(steps.min(1))
     })?;
     let seconds = t.elapsed().as_secs_f64();
-    Ok(Timing { threads, steps, particles: sim.particles.len(), seconds, rebuilds: sim.rebuild_count() - r0 })
+    Ok(Timing {
+        threads,
+        steps,
+        particles: sim.particles.len(),
+        seconds,
+        rebuilds: sim.rebuild_count() - r0,
+        evaluations: sim.force_evaluations() - e0,
+    })
 }
 
 /// Writes the particles as a LAMMPS data file (`atom_style sphere`, SI units): `Atoms` lines
@@ -290,6 +298,8 @@ pub struct Timing {
     pub particles: usize,
     pub seconds: f64,
     pub rebuilds: u64,
+    /// Force evaluations in the timed steps.
+    pub evaluations: u64,
 }
 
 impl Timing {
@@ -313,7 +323,28 @@ pub fn time_run(
     verlet_list: bool,
     energy: Option<crate::sim::EnergyMethod>,
 ) -> Result<Timing, DemError> {
+    time_run_with(case, state, threads, steps, verlet_list, energy, Integrator::VelocityVerlet)
+}
+
+/// Iterations per step the benchmark gives the implicit schemes (BD-p keeps its order with ≥ p; 4 for
+/// all three, so that their rows compare at the same cost).
+pub const BENCH_ITERATIONS: u32 = 4;
+
+/// [`time_run`] with the time integrator `integrator` (the implicit ones with [`BENCH_ITERATIONS`]).
+pub fn time_run_with(
+    case: &BoxCase,
+    state: &SimState<<HertzMindlin as crate::contact::ContactLaw>::State>,
+    threads: usize,
+    steps: u64,
+    verlet_list: bool,
+    energy: Option<crate::sim::EnergyMethod>,
+    integrator: Integrator,
+) -> Result<Timing, DemError> {
     let mut sim = dense_box(case);
+    sim.settings.integrator = integrator;
+    if integrator.scheme().is_some_and(|s| s.is_implicit()) {
+        sim.settings.iterations = Some(BENCH_ITERATIONS);
+    }
     sim.settings.verlet_list = verlet_list;
     sim.law.energy = energy.is_some();
     sim.energy_method = energy.unwrap_or_default();
@@ -323,6 +354,7 @@ pub fn time_run(
         .build()
         .map_err(|e| DemError::Config { key: "threads".into(), message: e.to_string() })?;
     let r0 = sim.rebuild_count();
+    let e0 = sim.force_evaluations();
     let t = Instant::now();
     pool.install(|| {
         // An energy budget at the end, as a run's output step would ask for it.
@@ -331,7 +363,14 @@ pub fn time_run(
         sim.run_steps(steps.min(1))
     })?;
     let seconds = t.elapsed().as_secs_f64();
-    Ok(Timing { threads, steps, particles: sim.particles.len(), seconds, rebuilds: sim.rebuild_count() - r0 })
+    Ok(Timing {
+        threads,
+        steps,
+        particles: sim.particles.len(),
+        seconds,
+        rebuilds: sim.rebuild_count() - r0,
+        evaluations: sim.force_evaluations() - e0,
+    })
 }
 
 /// Runs the benchmark and returns the lines to print. `quick` uses the reduced box and fewer steps.
@@ -403,9 +442,37 @@ pub fn bench(quick: bool) -> Result<Vec<String>, DemError> {
         "  memory: {:.0} bytes per particle between steps (particles, pair list with histories, wall candidates)",
         sim.bytes_per_particle()
     ));
+    lines.extend(bench_integrators(&case, &state, steps, one.rate())?);
     // The clumps start on a loose lattice six layers high: the bed needs about 0.15 s (30 000 steps)
     // to come to rest, whatever the footprint.
     lines.extend(bench_clumps(&case, CLUMP_SETTLE_STEPS, steps, one.rate(), two.rate())?);
+    Ok(lines)
+}
+
+/// One row per time integrator on the settled box, 1 thread: particle-steps/s, force evaluations per
+/// step (counted in the timed steps; the multi-step schemes take their first steps with RK4, which the
+/// count includes) and the rate relative to velocity Verlet (`vv_rate`, the first row of the bench).
+pub fn bench_integrators(
+    case: &BoxCase,
+    state: &SimState<<HertzMindlin as crate::contact::ContactLaw>::State>,
+    steps: u64,
+    vv_rate: f64,
+) -> Result<Vec<String>, DemError> {
+    use Integrator::*;
+    let mut lines = vec![format!(
+        "  integrators, 1 thread, {steps} steps each (implicit schemes with {BENCH_ITERATIONS} iterations):"
+    )];
+    for integrator in [VelocityVerlet, SymplecticEuler, Fe, Rk2, Rk4, Ab2, Ab4, Abm4, Bd1, Bd2, Bd4] {
+        let t =
+            time_run_with(case, state, 1, steps, true, Some(crate::sim::EnergyMethod::Residual), integrator)?;
+        lines.push(format!(
+            "    {:<5} {:.3e} particle-steps/s ({:.2}x velocity Verlet), {:.2} force evaluations per step",
+            integrator.label(),
+            t.rate(),
+            t.rate() / vv_rate,
+            t.evaluations as f64 / t.steps as f64
+        ));
+    }
     Ok(lines)
 }
 
@@ -479,5 +546,39 @@ mod tests {
         // coordination number 2·contacts/N exceeds 5 (the radii differ by at most 0.05 %).
         assert!(2.0 * e.pair_contacts as f64 > 5.0 * case.count() as f64, "{e:?}");
         assert!(e.max_overlap_ratio < 0.01, "{e:?}");
+    }
+
+    #[test]
+    fn the_integrator_rows_count_the_force_evaluations_of_each_scheme() {
+        // Evaluations per step once started (Jasion 2013, Table A.1): VV, SE, FE, AB2, AB4 one; RK2 and
+        // ABM4 two; RK4 four; BD1, BD2, BD4 the iteration count (velocity Verlet reuses the stored forces
+        // of the restored state for its first half kick). The multi-step
+        // schemes start with RK4 steps (4 evaluations each): AB2 needs one, AB4 and ABM4 three, BD2 one
+        // and BD4 three before their own formula takes over.
+        let case = BoxCase { cells: [3, 3, 2], ..BoxCase::full() };
+        let mut sim = dense_box(&case);
+        settle(&mut sim, 50).unwrap();
+        let state = sim.state();
+        let n = 20;
+        let count =
+            |integrator| time_run_with(&case, &state, 1, n, true, None, integrator).unwrap().evaluations;
+        use Integrator::*;
+        let it = BENCH_ITERATIONS as u64;
+        let all = [VelocityVerlet, SymplecticEuler, Fe, Rk2, Rk4, Ab2, Ab4, Abm4, Bd1, Bd2, Bd4];
+        let got: Vec<u64> = all.iter().map(|i| count(*i)).collect();
+        let want = vec![
+            n,
+            n,
+            n,
+            2 * n,
+            4 * n,
+            4 + (n - 1),
+            3 * 4 + (n - 3),
+            3 * 4 + 2 * (n - 3),
+            it * n,
+            4 + it * (n - 1),
+            3 * 4 + it * (n - 3),
+        ];
+        assert_eq!(got, want);
     }
 }

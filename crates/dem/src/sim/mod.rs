@@ -328,6 +328,8 @@ pub struct Simulation<L: ContactLaw> {
     trial_dt: Option<f64>,
     /// Buffers of the multi-stage integrators.
     stage: schemes::StageBuffers<L::State>,
+    /// Force evaluations since the simulation was made (not part of the state; for benchmarks).
+    evaluations: u64,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -367,6 +369,7 @@ impl<L: ContactLaw> Simulation<L> {
             evaluated_ids: 0,
             trial_dt: None,
             stage: Default::default(),
+            evaluations: 0,
         }
     }
 
@@ -629,6 +632,13 @@ impl<L: ContactLaw> Simulation<L> {
         self.check_finite()
     }
 
+    /// Force evaluations since the simulation was made (counted, not part of the checkpoint state): one
+    /// per step for velocity Verlet and symplectic Euler once started, more for the multi-stage and
+    /// implicit schemes.
+    pub fn force_evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
     /// Advances `n` steps.
     pub fn run_steps(&mut self, n: u64) -> Result<(), DemError> {
         for _ in 0..n {
@@ -663,6 +673,7 @@ impl<L: ContactLaw> Simulation<L> {
     /// Evaluates forces at the current state and checks for blow-up.
     fn evaluate(&mut self) -> Result<(), DemError> {
         self.compute_forces();
+        self.evaluations += 1;
         if !self.st.bodies.is_empty() {
             self.reduce_body_forces();
         }

@@ -97,3 +97,67 @@ impl Cylinder {
         (dist < reach).then_some((q, n, dist))
     }
 }
+
+/// Solid ball of `radius` about `center`; the particles move outside it (a spherical probe or
+/// obstacle). Contact curvature is ignored as for every analytic wall (R* = particle radius).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ball {
+    pub center: Vec3,
+    pub radius: f64,
+}
+
+impl Ball {
+    #[inline]
+    pub fn hit(&self, x: Vec3, reach: f64) -> Option<(Vec3, Vec3, f64)> {
+        let d = x - self.center;
+        let l = d.length();
+        // At the centre any direction is as good; +z keeps the choice deterministic.
+        let n = if l > 0.0 { d / l } else { Vec3::Z };
+        let dist = l - self.radius;
+        (dist < reach).then_some((self.center + self.radius * n, n, dist))
+    }
+}
+
+/// Solid circular cylinder with flat ends (a rod): the disc of `radius` about `base` perpendicular to
+/// the unit `axis`, swept a `length` along the axis. The particles move outside it; its faces, rim
+/// edges and side all make contact. A centre inside the rod reports a negative distance to the nearest
+/// face (and so a large overlap that blow-up detection catches).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Rod {
+    pub base: Vec3,
+    pub axis: Vec3,
+    pub radius: f64,
+    pub length: f64,
+}
+
+impl Rod {
+    #[inline]
+    pub fn hit(&self, x: Vec3, reach: f64) -> Option<(Vec3, Vec3, f64)> {
+        let d = x - self.base;
+        let h = d.dot(self.axis);
+        let rho = d - h * self.axis;
+        let l = rho.length();
+        let radial = if l > 0.0 { rho / l } else { spatter_core::math::orthonormal_basis(self.axis).0 };
+        let inside = h >= 0.0 && h <= self.length && l <= self.radius;
+        if !inside {
+            // Closest point of the solid: clamp the axial and radial coordinates.
+            let q = self.base + h.clamp(0.0, self.length) * self.axis + l.min(self.radius) * radial;
+            let r = x - q;
+            let dist = r.length();
+            if dist >= reach {
+                return None;
+            }
+            return Some((q, r / dist, dist));
+        }
+        // Inside: leave through the nearest face.
+        let (to_base, to_top, to_side) = (h, self.length - h, self.radius - l);
+        let (q, n, depth) = if to_base <= to_top && to_base <= to_side {
+            (x - h * self.axis, -self.axis, to_base)
+        } else if to_top <= to_side {
+            (x + to_top * self.axis, self.axis, to_top)
+        } else {
+            (self.base + h * self.axis + self.radius * radial, radial, to_side)
+        };
+        Some((q, n, -depth))
+    }
+}

@@ -4,6 +4,8 @@
 //! * [`Rectangle`] — a finite flat plate, two-sided, with edges and corners;
 //! * [`Cylinder`] — particles inside a tube or outside a post, optionally bounded along the axis (open
 //!   ends);
+//! * [`Ball`] and [`Rod`] — solid bodies the particles stay outside of (a sphere; a cylinder with flat
+//!   ends): probes and obstacles;
 //! * [`MeshWall`] — a triangle mesh (STL/OBJ) with face/edge/vertex contacts counted once
 //!   ([`mesh`]) and per-triangle impact records.
 //!
@@ -16,7 +18,7 @@
 mod analytic;
 pub mod mesh;
 
-pub use analytic::{Cylinder, Plane, Rectangle};
+pub use analytic::{Ball, Cylinder, Plane, Rectangle, Rod};
 pub use mesh::{MeshRecords, MeshWall};
 
 use spatter_core::motion::{Motion, Pose};
@@ -28,6 +30,8 @@ pub enum WallShape {
     Plane(Plane),
     Rectangle(Rectangle),
     Cylinder(Cylinder),
+    Ball(Ball),
+    Rod(Rod),
     Mesh(Box<MeshWall>),
 }
 
@@ -125,6 +129,8 @@ impl Wall {
             WallShape::Plane(p) => (p.point - center).length() + fallback,
             WallShape::Rectangle(r) => (r.center - center).length() + r.half_u.length() + r.half_v.length(),
             WallShape::Cylinder(c) => (c.point - center).length() + c.radius + fallback,
+            WallShape::Ball(b) => (b.center - center).length() + b.radius,
+            WallShape::Rod(r) => (r.base - center).length() + r.length + r.radius,
             WallShape::Mesh(m) => m.mesh.vertices.iter().map(|v| (*v - center).length()).fold(0.0, f64::max),
         }
     }
@@ -151,6 +157,8 @@ impl Wall {
             WallShape::Plane(p) => p.hit(x, reach),
             WallShape::Rectangle(r) => r.hit(x, reach),
             WallShape::Cylinder(c) => c.hit(x, reach),
+            WallShape::Ball(b) => b.hit(x, reach),
+            WallShape::Rod(r) => r.hit(x, reach),
             WallShape::Mesh(_) => None,
         }
     }

@@ -404,3 +404,58 @@ fn a_contact_sliding_across_a_seam_through_rebuilds_and_a_checkpoint_is_one_impa
     check(Stateless::default(), "stateless");
     check(HertzMindlin::default(), "Hertz–Mindlin");
 }
+
+#[test]
+fn ball_and_rod_contacts_on_faces_edges_and_inside() {
+    // Closest-point geometry (exact up to round-off, 1e-12): a ball of radius 2 cm at the origin and a
+    // rod of radius 1 cm from z = 0 to z = 5 cm along +z.
+    let near = |a: Vec3, b: Vec3| (a - b).length() < 1e-12;
+    let ball = Ball { center: Vec3::ZERO, radius: 0.02 };
+    // 3-4-5 direction at distance 0.025 from the centre: 5 mm from the surface, normal outward.
+    let (q, n, d) = ball.hit(Vec3::new(0.015, 0.0, 0.02), 0.006).unwrap();
+    assert!(near(n, Vec3::new(0.6, 0.0, 0.8)) && near(q, Vec3::new(0.012, 0.0, 0.016)));
+    assert!((d - 0.005).abs() < 1e-12);
+    assert_eq!(ball.hit(Vec3::new(0.015, 0.0, 0.02), 0.005), None, "beyond the reach");
+    let (_, _, d) = ball.hit(Vec3::new(0.0, 0.0, 0.01), 0.001).unwrap();
+    assert!((d + 0.01).abs() < 1e-12, "inside the ball the distance is negative: {d}");
+
+    let rod = Rod { base: Vec3::ZERO, axis: Vec3::Z, radius: 0.01, length: 0.05 };
+    // Below the flat end: normal −z, contact point straight above.
+    let (q, n, d) = rod.hit(Vec3::new(0.004, 0.003, -0.002), 0.003).unwrap();
+    assert!(near(q, Vec3::new(0.004, 0.003, 0.0)) && near(n, -Vec3::Z) && (d - 0.002).abs() < 1e-12);
+    // Beside the side: radial normal.
+    let (q, n, d) = rod.hit(Vec3::new(0.0, 0.013, 0.02), 0.004).unwrap();
+    assert!(near(q, Vec3::new(0.0, 0.01, 0.02)) && near(n, Vec3::Y) && (d - 0.003).abs() < 1e-12);
+    // Off the lower rim, 3 mm out and 4 mm down: distance 5 mm, normal (0.6, 0, −0.8).
+    let (q, n, d) = rod.hit(Vec3::new(0.013, 0.0, -0.004), 0.006).unwrap();
+    assert!(near(q, Vec3::new(0.01, 0.0, 0.0)) && near(n, Vec3::new(0.6, 0.0, -0.8)));
+    assert!((d - 0.005).abs() < 1e-12);
+    // Above the top end, and inside near the bottom face (leaves through it: distance −1 mm, normal −z).
+    let (_, n, _) = rod.hit(Vec3::new(0.0, 0.0, 0.052), 0.003).unwrap();
+    assert!(near(n, Vec3::Z));
+    let (_, n, d) = rod.hit(Vec3::new(0.002, 0.0, 0.001), 0.001).unwrap();
+    assert!(near(n, -Vec3::Z) && (d + 0.001).abs() < 1e-12, "inside: {n} {d}");
+    let (_, n, d) = rod.hit(Vec3::new(0.0, -0.009, 0.02), 0.001).unwrap();
+    assert!(near(n, -Vec3::Y) && (d + 0.001).abs() < 1e-12, "inside near the side: {n} {d}");
+}
+
+#[test]
+fn a_sphere_reflects_off_a_ball_and_off_a_rod_end_as_off_a_rigid_body() {
+    // Elastic, frictionless: v' = v − 2(v·n)n with n the contact normal (tolerances as in the rectangle
+    // test above). A sphere falling onto the top of a ball at a horizontal offset b from its centre line
+    // touches it with n = (b/(R + r), 0, √(1 − (b/(R + r))²)); the rotation of the normal during the
+    // contact is small (t_c ≈ 53 µs at 1 m/s), 5e-3 V per component. Onto a rod's flat end: v' = −v.
+    let r = 0.01;
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    let ball = WallShape::Ball(Ball { center: Vec3::ZERO, radius: 0.02 });
+    let s = 0.6;
+    let zc = 0.03 * (1.0f64 - s * s).sqrt();
+    let v = elastic_frictionless(ball, Vec3::new(0.03 * s, 0.0, zc + 1e-5), down);
+    let expect = Vec3::new(2.0 * s * 0.8, 0.0, 2.0 * 0.8 * 0.8 - 1.0);
+    assert!((v - expect).abs().max_element() < 5e-3, "ball: {v} vs {expect}");
+    assert!((v.length() - 1.0).abs() < 1e-5);
+    let rod =
+        WallShape::Rod(Rod { base: Vec3::new(0.0, 0.0, -0.05), axis: Vec3::Z, radius: 0.02, length: 0.05 });
+    let v = elastic_frictionless(rod, Vec3::new(0.005, 0.0, r + 1e-5), down);
+    assert!((v - Vec3::Z).length() < 1e-5, "rod end: {v}");
+}

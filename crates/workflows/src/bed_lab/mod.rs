@@ -4,5 +4,6 @@
 
 pub mod bed_file;
 pub mod integrator_study;
+pub mod probe_analysis;
 
 pub use integrator_study::{run as run_integrator_study, IntegratorStudyConfig};

@@ -67,6 +67,9 @@ pub struct SceneConfig {
     /// Start from the spheres of a bed file (see `docs/bed.md`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bed: Option<BedStart>,
+    /// A probe driven into the bed (see `docs/bed.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<ProbeConfig>,
     #[serde(default)]
     pub output: OutputConfig,
 }
@@ -436,6 +439,7 @@ fn one() -> f64 {
 }
 
 pub use super::pour::PourConfig;
+pub use super::probe::{ProbeConfig, ProbeShape};
 pub use crate::motions::{MotionConfig, MotionType};
 
 /// A region for fills and injections (`type = "box" | "cylinder" | "mesh"`).
@@ -1018,6 +1022,9 @@ impl Validate for SceneConfig {
         if let Some(p) = &self.pour {
             super::pour::check(c, self, p);
         }
+        if let Some(p) = &self.probe {
+            super::probe::check(c, self, p);
+        }
         if let Some(b) = &self.bed {
             c.nested("bed", |c| {
                 let full = c.resolve(&b.file);
@@ -1120,7 +1127,7 @@ impl Validate for SceneConfig {
 impl spatter_io::run::Smoke for SceneConfig {
     /// 40 steps, an output at the start, half-way and the end; fills of a counted size keep at most 200
     /// particles (lattice and fraction fills keep their region: they are set up, not stepped, in bulk), a
-    /// pour at most 50.
+    /// pour at most 50, a probe's largest depth what half the run can reach.
     fn smoke(&mut self) {
         self.duration_s = self.duration_s.min(40.0 * self.dt_s);
         self.output_interval_s = self.output_interval_s.min(20.0 * self.dt_s);
@@ -1131,6 +1138,13 @@ impl spatter_io::run::Smoke for SceneConfig {
         }
         if let Some(p) = &mut self.pour {
             p.count = p.count.min(50);
+        }
+        // A probe goes as deep as half the shortened run allows (it usually stays above the bed).
+        if let Some(p) = &mut self.probe {
+            p.max_depth_m = p.max_depth_m.min(0.5 * self.duration_s * p.speed_m_s);
+            if let Some(d) = &mut p.immersion_depth_m {
+                *d = d.min(0.5 * p.max_depth_m);
+            }
         }
     }
 }

@@ -6,6 +6,7 @@ mod clumps;
 mod config;
 pub mod events;
 pub mod pour;
+pub mod probe;
 mod run;
 pub mod setup;
 
@@ -18,5 +19,7 @@ pub use run::{
 
 #[cfg(test)]
 mod pour_tests;
+#[cfg(test)]
+mod probe_tests;
 #[cfg(test)]
 mod tests;

@@ -202,3 +202,73 @@ fn bad_pours_and_bed_files_are_refused_with_the_key() {
     let e = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap_err().to_string();
     assert!(e.contains("pour.region") && e.contains("region's top"), "{e}");
 }
+
+/// A pour into a vertical cylinder (radius 5.64 cm, the area of the 10 × 10 cm box above) inside a
+/// cylindrical wall: every sphere ends inside the cylinder, up to its overlap with the wall — a
+/// frictionless bed presses on its wall with its full hydrostatic pressure, φ ρ g h ≈ 1.3 kPa at the
+/// floor, about 0.13 N on a wall sphere, 1.3·10⁻⁵ m of overlap at k = 10⁴ N/m, several times that where
+/// the packing concentrates the load (we measure 4.2·10⁻⁵ m); the bound is 10⁻⁴ m = 10⁻² d, far below
+/// the radius a sphere outside the wall would show — and the frictionless core — a 6 × 6 × 4
+/// d box on the axis, at least 1.4 d from the wall, 2 d above the floor and below the surface — packs
+/// at random close packing as in the box (0.64 ± 0.025, the tolerance and reference of
+/// `frictionless_pour_packs_near_random_close_packing_and_friction_packs_looser`).
+#[test]
+fn a_cylinder_pour_stays_inside_its_wall_and_packs_like_the_box() {
+    let radius = 0.0564;
+    let text = format!(
+        r#"
+dt_s = 4e-5
+duration_s = 4.0
+output_interval_s = 0.02
+seed = 5
+[contact]
+normal = "hooke"
+hooke_stiffness_n_m = 1e4
+tangential = "linear"
+[engine]
+track_energy = false
+[materials.glass]
+youngs_modulus_pa = 6e10
+poisson_ratio = 0.25
+density_kg_m3 = 2500
+[pair_defaults]
+friction = 0.0
+restitution = 0.3
+[[walls]]
+name = "floor"
+material = "glass"
+shape = {{ type = "plane", point_m = [0, 0, 0], normal = [0, 0, 1] }}
+[[walls]]
+name = "die"
+material = "glass"
+shape = {{ type = "cylinder", point_m = [0, 0, 0], axis = [0, 0, 1], radius_m = {radius}, inside = true }}
+[pour]
+material = "glass"
+size = {{ kind = "mono", diameter = 0.01 }}
+region = {{ type = "cylinder", base_m = [0, 0, 0], axis = [0, 0, 1], radius_m = {radius}, height_m = 0.5 }}
+count = 1000
+interval_s = 0.001
+[output]
+particles_vtu = false
+[[output.packing]]
+name = "core"
+min_m = [-0.03, -0.03, 0.02]
+max_m = [0.03, 0.03, 0.06]
+"#
+    );
+    let cfg = parse(&text);
+    Checker::run(&cfg, None).unwrap_or_else(|e| panic!("{e:?}"));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = RunDir::create(tmp.path()).unwrap();
+    let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scalar(&s, "poured"), 1000.0);
+    assert!(scalar(&s, "settled_s") < 4.0, "settled before the end: {:?}", s.headline);
+    let bed = crate::bed_lab::bed_file::read(&dir.path("bed.txt"), &["glass"]).unwrap();
+    assert_eq!(bed.len(), 1000);
+    let worst =
+        bed.iter().map(|b| b.pos.x.hypot(b.pos.y) + b.radius - radius).fold(f64::NEG_INFINITY, f64::max);
+    assert!(worst < 1e-4, "a sphere reaches {worst:e} m beyond the wall");
+    let phi = scalar(&s, "packing_core");
+    eprintln!("cylinder pour: core packing {phi:.4}, settled at {:.3} s", scalar(&s, "settled_s"));
+    assert!((phi - 0.64).abs() < 0.025, "core packing {phi}");
+}

@@ -44,6 +44,8 @@ struct Checkpoint<S, P> {
     warnings: Vec<String>,
     /// Progress of the `[pour]` (None without one).
     pour: Option<super::pour::PourState>,
+    /// The probe's state and samples (None without `[probe]`).
+    probe: Option<super::probe::ProbeState>,
 }
 
 /// Runs a DEM scene into `ctx.dir`: `energy.csv`, `particles.pvd` + `particles/*.vtu`, and for every mesh
@@ -477,6 +479,8 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         None => 0,
     };
     let pour_every = cfg.pour.as_ref().map_or(1, |p| ((p.interval_s / cfg.dt_s).round() as u64).max(1));
+    let mut probe = None;
+    let probe_every = cfg.probe.as_ref().map_or(1, |p| super::probe::sample_every(p, cfg.dt_s));
     if ctx.resume {
         let ck: Checkpoint<L::State, P::State> = ctx.load_checkpoint().map_err(DemError::from)?;
         sim.restore(ck.sim).map_err(DemError::Resume)?;
@@ -527,9 +531,16 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             return Err(DemError::Resume("the [pour] table was added or removed".into()).into());
         }
         pour = ck.pour;
+        if cfg.probe.is_some() != ck.probe.is_some() {
+            return Err(DemError::Resume("the [probe] table was added or removed".into()).into());
+        }
+        probe = ck.probe;
         tracing::info!("resumed at step {} (t = {} s)", sim.step_count(), t);
     } else {
-        let initial = setup::initial_particles(cfg, &sim.walls, sim.templates())?;
+        // The fills do not avoid the probe (the last wall): a probe placed in the bed is an error, not a
+        // hole in it.
+        let container = sim.walls.len() - usize::from(cfg.probe.is_some());
+        let initial = setup::initial_particles(cfg, &sim.walls[..container], sim.templates())?;
         for p in initial.spheres {
             sim.add_particle(p);
         }
@@ -539,6 +550,9 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         for t in sim.templates() {
             let path = dir.path(&format!("templates/{}.vtu", t.name));
             spatter_dem::clump::fill::write_template_vtu(t, &path).map_err(io(&path))?;
+        }
+        if let Some(p) = &cfg.probe {
+            probe = Some(super::probe::start(p, &sim)?);
         }
         warnings = time_step_warnings(cfg, &sim);
         for w in &warnings {
@@ -585,6 +599,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                 events: events.clone(),
                 warnings: warnings.clone(),
                 pour: pour.clone(),
+                probe: probe.clone(),
             };
             ctx.save_checkpoint(&ck).map_err(DemError::from)?;
             write_events(cfg, &sim, &events, ctx)?;
@@ -609,11 +624,19 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                 super::pour::add_next(&mut sim, p, pour_material, state)?;
             }
         }
-        if (step + 1) % out_every == 0 || step + 1 == total_steps {
+        // The step that takes the probe to its largest depth ends the run with an output.
+        let probe_ends = match (&cfg.probe, &probe) {
+            (Some(p), Some(st)) => st.depth(p.speed_m_s, sim.time() + cfg.dt_s) >= p.max_depth_m,
+            _ => false,
+        };
+        if (step + 1) % out_every == 0 || step + 1 == total_steps || probe_ends {
             sim.request_energy();
         }
         partner.before_step(&mut sim)?;
         sim.step()?;
+        if let (Some(p), Some(st)) = (&cfg.probe, probe.as_mut()) {
+            super::probe::after_step(p, &sim, st, probe_every);
+        }
         if let Some(e) = &cfg.output.events {
             events.after_step(&sim, e);
         }
@@ -624,7 +647,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                 }
             }
         }
-        if sim.step_count() % out_every == 0 || sim.step_count() == total_steps {
+        if sim.step_count() % out_every == 0 || sim.step_count() == total_steps || probe_ends {
             out.write(cfg, &sim, ctx)?;
             partner.output(&sim, ctx)?;
             // A pour is checked for rest at the outputs, so that a run ending early ends on one.
@@ -638,6 +661,10 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                 }
             }
         }
+        if probe_ends {
+            tracing::info!("probe at its largest depth at t = {:.6} s", sim.time());
+            break;
+        }
         if sim.step_count() % 200 == 0 {
             ctx.control.progress(sim.step_count(), total_steps);
         }
@@ -647,6 +674,9 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     let _ = std::fs::remove_file(dir.checkpoint_path());
     let mut s = summary(cfg, &sim, &injectors, &warnings, ctx);
     super::bed_outputs::finish(cfg, &sim, pour.as_ref(), ctx, &mut s)?;
+    if let (Some(p), Some(st)) = (&cfg.probe, &probe) {
+        super::probe::finish(p, st, ctx, &mut s)?;
+    }
     if cfg.output.events.is_some() {
         let (hit, crossed) = events.counts();
         s.scalar("objects_hit_wall", hit as f64);

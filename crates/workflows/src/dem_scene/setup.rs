@@ -158,6 +158,10 @@ pub fn build(cfg: &SceneConfig) -> Result<Built, DemError> {
         };
         walls.push(Wall { name: w.name.clone(), shape, material, motion });
     }
+    if let Some(p) = &cfg.probe {
+        let material = material_index(cfg, &p.material, "probe.material")?;
+        walls.push(super::probe::wall(p, material)?);
+    }
     let mut templates = Vec::with_capacity(cfg.templates.len());
     for (name, t) in &cfg.templates {
         templates.push(t.build(name)?);

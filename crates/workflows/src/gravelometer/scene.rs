@@ -432,6 +432,7 @@ pub fn scene(cfg: &GravelometerConfig, plan: &Plan, geometry: &Path) -> SceneCon
         templates,
         pour: None,
         bed: None,
+        probe: None,
         wear: vec![WearConfig {
             particle_material: "stone".to_string(),
             wall_material: "coating".to_string(),
