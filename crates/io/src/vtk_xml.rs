@@ -19,6 +19,14 @@ impl Values {
             Values::I64(v) => v.len(),
         }
     }
+
+    /// The VTK type name of the values.
+    pub(crate) fn type_name(&self) -> &'static str {
+        match self {
+            Values::F64(_) => "Float64",
+            Values::I64(_) => "Int64",
+        }
+    }
 }
 
 /// A named data array with `components` values per entity.
@@ -46,9 +54,10 @@ fn encode(bytes: &[u8]) -> String {
 
 /// Writes one `<DataArray>` element.
 pub(crate) fn write_array(s: &mut String, name: &str, components: usize, values: &Values) {
-    let (ty, bytes): (&str, Vec<u8>) = match values {
-        Values::F64(v) => ("Float64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        Values::I64(v) => ("Int64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+    let ty = values.type_name();
+    let bytes: Vec<u8> = match values {
+        Values::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        Values::I64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
     };
     let _ = writeln!(
         s,

@@ -3,7 +3,7 @@
 //!
 //! Arrays are stored inline in VTK's `binary` format ([`crate::vtk_xml`]).
 
-use crate::vtk_xml::{push, write_array, write_section, write_u8_array, Array, Values};
+use crate::vtk_xml::{push, write_array, write_section, write_u8_array, xml_escape, Array, Values};
 use spatter_core::Vec3;
 use std::fmt::Write as _;
 use std::io;
@@ -155,6 +155,45 @@ impl Vtu {
         std::fs::write(path, self.to_xml())
             .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))
     }
+
+    /// The text of a parallel file (`.pvtu`) joining `pieces` (paths relative to the `.pvtu`), each a
+    /// `.vtu` with the arrays of this builder (names, types and components are taken from it; its own
+    /// points are not written). ParaView reads the pieces as one data set.
+    pub fn pvtu_xml(&self, pieces: &[String]) -> String {
+        let mut s = String::with_capacity(512 + 64 * pieces.len());
+        s.push_str("<?xml version=\"1.0\"?>\n");
+        s.push_str(
+            "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+        );
+        s.push_str("  <PUnstructuredGrid GhostLevel=\"0\">\n");
+        for (tag, arrays) in [("PPointData", &self.point_data), ("PCellData", &self.cell_data)] {
+            let _ = writeln!(s, "    <{tag}>");
+            for a in arrays {
+                let _ = writeln!(
+                    s,
+                    "      <PDataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"/>",
+                    a.values.type_name(),
+                    xml_escape(&a.name),
+                    a.components
+                );
+            }
+            let _ = writeln!(s, "    </{tag}>");
+        }
+        s.push_str(
+            "    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n    </PPoints>\n",
+        );
+        for p in pieces {
+            let _ = writeln!(s, "    <Piece Source=\"{}\"/>", xml_escape(p));
+        }
+        s.push_str("  </PUnstructuredGrid>\n</VTKFile>\n");
+        s
+    }
+
+    /// Writes [`Self::pvtu_xml`] to `path`.
+    pub fn write_pvtu(&self, path: &Path, pieces: &[String]) -> io::Result<()> {
+        std::fs::write(path, self.pvtu_xml(pieces))
+            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))
+    }
 }
 
 #[cfg(test)]
@@ -196,6 +235,27 @@ mod tests {
         assert_eq!((radius.components, &radius.values), (1, &vec![0.01, 0.02]));
         assert_eq!(d.point_array("velocity_m_s").unwrap().values, vec![1.0, 0.0, 0.0, 0.0, -2.5, 0.0]);
         assert_eq!(d.point_array("id").unwrap().values, vec![7.0, 9.0]);
+    }
+
+    /// A `.pvtu` names every piece and declares the pieces' arrays with their types and components (VTK's
+    /// own reader joins them in `tests/vtk_reader.rs`).
+    #[test]
+    fn pvtu_joins_pieces() {
+        let dir = tempfile::tempdir().unwrap();
+        let piece = |pos: &[Vec3], ids: &[i64]| {
+            Vtu::point_cloud(pos).point_scalar("rho", &vec![1000.0; pos.len()]).point_int("id", ids)
+        };
+        let a = piece(&[Vec3::ZERO, Vec3::X], &[0, 1]);
+        let b = piece(&[Vec3::Y], &[2]);
+        a.write(&dir.path().join("p_r0000.vtu")).unwrap();
+        b.write(&dir.path().join("p_r0001.vtu")).unwrap();
+        let pieces = vec!["p_r0000.vtu".to_string(), "p_r0001.vtu".to_string()];
+        let path = dir.path().join("p.pvtu");
+        a.write_pvtu(&path, &pieces).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("<PDataArray type=\"Float64\" Name=\"rho\" NumberOfComponents=\"1\"/>"));
+        assert!(text.contains("<PDataArray type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\"/>"));
+        assert_eq!(text.matches("<Piece Source=").count(), 2);
     }
 
     #[test]

@@ -120,3 +120,38 @@ print("ok")
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && stdout.trim() == "ok", "VTK rejected our .vtr:\n{stdout}\n{stderr}");
 }
+
+/// Pieces written on several ranks and the `.pvtu` joining them read as one data set of every particle.
+#[test]
+fn vtk_reads_pieces_through_a_pvtu() {
+    if !vtk_available() {
+        assert!(
+            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
+            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
+        );
+        eprintln!("skipped: python3-vtk9 is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let piece = |pos: &[Vec3], ids: &[i64]| {
+        Vtu::point_cloud(pos).point_vector("velocity_m_s", &vec![Vec3::X; pos.len()]).point_int("id", ids)
+    };
+    let a = piece(&[Vec3::ZERO, Vec3::X], &[0, 1]);
+    let b = piece(&[Vec3::Y], &[2]);
+    let empty = piece(&[], &[]);
+    a.write(&dir.path().join("p_r0000.vtu")).unwrap();
+    b.write(&dir.path().join("p_r0001.vtu")).unwrap();
+    empty.write(&dir.path().join("p_r0002.vtu")).unwrap();
+    let pieces: Vec<String> = (0..3).map(|r| format!("p_r{r:04}.vtu")).collect();
+    let path = dir.path().join("p.pvtu");
+    a.write_pvtu(&path, &pieces).unwrap();
+    let script = format!(
+        "import vtk\nr = vtk.vtkXMLPUnstructuredGridReader()\nr.SetFileName({:?})\nr.Update()\n\
+         o = r.GetOutput()\nprint(o.GetNumberOfPoints(), o.GetPointData().GetArray('id').GetRange(), \
+         o.GetPointData().GetArray('velocity_m_s').GetNumberOfComponents())",
+        path.to_str().unwrap()
+    );
+    let o = Command::new(PYTHON).args(["-c", &script]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "3 (0.0, 2.0) 3");
+}

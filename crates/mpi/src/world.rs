@@ -100,7 +100,9 @@ impl Comm for MpiComm {
         w.all_gather_into(&count(local.len()), &mut counts[..]);
         let displs = displacements(&counts);
         let mut buf = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
-        {
+        // Every rank knows every count: when all are zero no payload round is needed (and OpenMPI would
+        // reject the empty buffers).
+        if !buf.is_empty() {
             let mut part = PartitionMut::new(&mut buf[..], &counts[..], &displs[..]);
             w.all_gather_varcount_into(local, &mut part);
         }
@@ -138,8 +140,9 @@ impl Comm for MpiComm {
             }
         }
         mpi::request::multiple_scope(2 * n, |scope, requests| {
+            // Empty payloads are not sent: both sides know the size from the first round.
             for (k, &p) in peers.iter().enumerate() {
-                if p != self.rank {
+                if p != self.rank && !out[k].is_empty() {
                     requests.add(w.process_at_rank(p as i32).immediate_send_with_tag(
                         scope,
                         &out[k][..],
@@ -148,7 +151,7 @@ impl Comm for MpiComm {
                 }
             }
             for (k, buf) in got.iter_mut().enumerate() {
-                if peers[k] != self.rank {
+                if peers[k] != self.rank && !buf.is_empty() {
                     requests.add(w.process_at_rank(peers[k] as i32).immediate_receive_into_with_tag(
                         scope,
                         &mut buf[..],
@@ -203,7 +206,11 @@ impl Comm for MpiComm {
         let mut len = buf.len() as u64;
         root_process.broadcast_into(&mut len);
         buf.resize(len as usize, 0);
-        root_process.broadcast_into(&mut buf[..]);
+        // OpenMPI rejects the dangling pointer of an empty slice (MPI_ERR_ARG); every rank knows the
+        // length now, so an empty payload is simply not sent.
+        if len > 0 {
+            root_process.broadcast_into(&mut buf[..]);
+        }
     }
     fn barrier(&self) {
         world().barrier();

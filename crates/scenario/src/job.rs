@@ -12,7 +12,7 @@
 //! scenario, another format version or a damaged file is refused with a sentence before the scenario
 //! starts (see [`spatter_io::checkpoint`]).
 
-use crate::kinds::{Loaded, RunError};
+use crate::kinds::{Loaded, RunError, KIND_RANKS};
 use serde_json::Value;
 use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::control::{Finished, RunControl};
@@ -96,8 +96,10 @@ pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Resu
 }
 
 /// [`run`] on the ranks of `comm` (a run started by `mpirun`). Every rank calls it and every rank returns
-/// the same error. No kind is split over ranks yet, so several ranks are refused before the run folder is
-/// touched; one rank is the ordinary run.
+/// an error when one does. Kinds that are not split over ranks ([`crate::Scenario::runs_on_ranks`]) and
+/// `--resume` are refused on several ranks before the run folder is touched; one rank is the ordinary
+/// run. On several ranks rank 0 alone prepares the folder, writes `run.toml`, `log.txt`, `summary.json`
+/// and the report; the others learn the outcome of each of these from it.
 pub fn run_with_comm(
     loaded: &Loaded,
     opts: &JobOptions,
@@ -105,12 +107,24 @@ pub fn run_with_comm(
     comm: &dyn Comm,
 ) -> Result<RunSummary, JobError> {
     if comm.size() > 1 {
-        return Err(JobError::Ranks(format!(
-            "started on {} ranks, but kind `{}` runs in one process (no kind is split over MPI ranks yet); \
-             start it without mpirun, with --threads for the cores of this machine",
-            comm.size(),
-            loaded.scenario.kind()
-        )));
+        if !loaded.scenario.runs_on_ranks() {
+            let split: Vec<String> =
+                KIND_RANKS.iter().filter(|k| k.1).map(|k| format!("`{}`", k.0)).collect();
+            return Err(JobError::Ranks(format!(
+                "started on {} ranks, but kind `{}` runs in one process (kinds split over MPI ranks: {}); \
+                 start it without mpirun, with --threads for the cores of this machine",
+                comm.size(),
+                loaded.scenario.kind(),
+                split.join(", ")
+            )));
+        }
+        if opts.resume {
+            return Err(JobError::Ranks(format!(
+                "started on {} ranks with --resume: runs on several ranks write no checkpoint yet, and a \
+                 checkpoint of one process resumes in one process; resume without mpirun",
+                comm.size()
+            )));
+        }
     }
     if !(opts.checkpoint_interval_s > 0.0 && opts.checkpoint_interval_s.is_finite()) {
         return Err(JobError::Folder(format!(
@@ -120,6 +134,9 @@ pub fn run_with_comm(
     }
     let resolved = loaded.scenario.resolved_toml().map_err(|e| JobError::Folder(e.to_string()))?;
     let hash = input_hash(&resolved);
+    if comm.size() > 1 {
+        return run_on_ranks(loaded, opts, control, comm, &resolved, hash);
+    }
     let dir = prepare_folder(opts, hash)?;
     dir.write_text("run.toml", &resolved)?;
     let earlier_wall_s = if opts.resume { earlier_wall_time(&dir) } else { 0.0 };
@@ -133,6 +150,98 @@ pub fn run_with_comm(
     spatter_io::runlog::close();
     if let Some(p) = previous_log {
         spatter_io::runlog::open(&p, true)?;
+    }
+    result
+}
+
+/// Rank 0's outcome of a step only it takes (`Ok` or the error text), shared with every rank: rank 0
+/// returns its own error, the others a [`JobError::Folder`] (folder steps) or [`JobError::Run`] with the
+/// same text.
+fn shared<T>(
+    comm: &dyn Comm,
+    mine: Option<Result<T, JobError>>,
+    other: fn(String) -> JobError,
+) -> Result<Option<T>, JobError> {
+    let mut text = match &mine {
+        Some(Err(e)) => e.to_string().into_bytes(),
+        _ => Vec::new(),
+    };
+    comm.broadcast_bytes(0, &mut text);
+    match mine {
+        Some(r) => r.map(Some),
+        None if text.is_empty() => Ok(None),
+        None => Err(other(String::from_utf8_lossy(&text).into_owned())),
+    }
+}
+
+/// A run on several ranks (see [`run_with_comm`]).
+fn run_on_ranks(
+    loaded: &Loaded,
+    opts: &JobOptions,
+    control: &dyn RunControl,
+    comm: &dyn Comm,
+    resolved: &str,
+    hash: u64,
+) -> Result<RunSummary, JobError> {
+    let root = comm.is_root();
+    let prepared = root.then(|| {
+        let dir = prepare_folder(opts, hash)?;
+        dir.write_text("run.toml", resolved)?;
+        Ok(dir)
+    });
+    let dir = match shared(comm, prepared, JobError::Folder)? {
+        Some(dir) => dir,
+        // Rank 0 has created the folder.
+        None => RunDir::create(&opts.out)?,
+    };
+    let previous_log = spatter_io::runlog::current();
+    if root {
+        spatter_io::runlog::open(&dir.root().join("log.txt"), false)?;
+        tracing::info!(
+            "spatter {} {} scenario {} → {} on {} ranks × {} thread(s)",
+            env!("CARGO_PKG_VERSION"),
+            loaded.scenario.kind(),
+            loaded.source.path.display(),
+            dir.root().display(),
+            comm.size(),
+            rayon::current_num_threads()
+        );
+    }
+    let timed = Timed::new(control, Duration::from_secs_f64(opts.checkpoint_interval_s));
+    let ctx = RunContext { dir: &dir, control: &timed, resume: false, input_hash: hash, comm };
+    let started = Instant::now();
+    // The scenario's errors are collective (every rank returns the same one); a failed write on one rank
+    // ends the whole run there.
+    let result = loaded.scenario.run(&ctx).map_err(JobError::Run);
+    let wall = started.elapsed().as_secs_f64();
+    let result = match result {
+        Ok(summary) => {
+            let written = root.then(|| {
+                for line in &summary.headline {
+                    tracing::info!("{line}");
+                }
+                check_finite(dir.root(), &summary)?;
+                write_summary(&dir, loaded, &summary, wall)?;
+                match summary.finished {
+                    Finished::Completed => {
+                        tracing::info!("completed in {wall:.3} s on {} ranks", comm.size())
+                    }
+                    Finished::Interrupted => tracing::info!("interrupted after {wall:.3} s"),
+                }
+                Ok(())
+            });
+            shared(comm, written, |t| JobError::Run(t.into())).map(|_| summary)
+        }
+        Err(e) => Err(e),
+    };
+    if root {
+        if let Err(e) = &result {
+            tracing::error!("{e}");
+        }
+        spatter_io::runlog::close();
+        if let Some(p) = previous_log {
+            spatter_io::runlog::open(&p, true)?;
+        }
     }
     result
 }

@@ -2,7 +2,9 @@
 //! read into, and the function that runs it.
 //!
 //! Adding a kind is one line in the `kinds!` invocation below: the name, the variant, the configuration
-//! type (serde + [`Validate`]) and its `run(&Config, &RunContext) -> Result<RunSummary, E>` function.
+//! type (serde + [`Validate`]), its `run(&Config, &RunContext) -> Result<RunSummary, E>` function, and
+//! whether it runs split over several ranks (`ranks = true`: its `run` joins the collectives of
+//! `ctx.comm`; see `docs/architecture.md`, "Running under mpirun").
 
 #[allow(unused_imports)]
 use crate::parse::{typed, validate, ScenarioError};
@@ -17,9 +19,12 @@ use std::path::Path;
 pub type RunError = Box<dyn std::error::Error + Send + Sync>;
 
 macro_rules! kinds {
-    ($( $name:literal => $variant:ident($cfg:ty, $run:path), $doc:literal; )*) => {
+    ($( $name:literal => $variant:ident($cfg:ty, $run:path), ranks = $ranks:literal, $doc:literal; )*) => {
         /// Every accepted value of `kind`.
         pub const KINDS: &[&str] = &[$($name),*];
+
+        /// Every kind with whether it runs split over several ranks.
+        pub const KIND_RANKS: &[(&str, bool)] = &[$(($name, $ranks)),*];
 
         /// A scenario read and validated from a file.
         #[derive(Debug)]
@@ -32,6 +37,12 @@ macro_rules! kinds {
             /// The `kind` this scenario was read as.
             pub fn kind(&self) -> &'static str {
                 match *self { $( Scenario::$variant(_) => $name, )* }
+            }
+
+            /// True when the kind runs split over several ranks (`mpirun -n N`); the others are refused on
+            /// several ranks.
+            pub fn runs_on_ranks(&self) -> bool {
+                match *self { $( Scenario::$variant(_) => $ranks, )* }
             }
 
             /// Runs the scenario in `ctx`.
@@ -68,27 +79,27 @@ macro_rules! kinds {
 }
 
 kinds! {
-    "dem" => Dem(spatter_workflows::dem_scene::SceneConfig, spatter_workflows::dem_scene::run),
+    "dem" => Dem(spatter_workflows::dem_scene::SceneConfig, spatter_workflows::dem_scene::run), ranks = false,
         "A DEM scene: materials, particles (fills, injectors), walls (planes, cylinders, STL meshes with motion).";
-    "sph" => Sph(spatter_workflows::sph_scene::SphConfig, spatter_workflows::sph_scene::run),
+    "sph" => Sph(spatter_workflows::sph_scene::SphConfig, spatter_workflows::sph_scene::run), ranks = true,
         "Free-surface water (WCSPH) with walls and moving bodies: wetting maps, splash heights, probes.";
-    "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run),
+    "snow_regime_map" => SnowRegimeMap(spatter_workflows::snow::SnowConfig, spatter_workflows::snow::run), ranks = false,
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
-    "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run),
+    "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run), ranks = false,
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
-    "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run),
+    "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run), ranks = false,
         "A vehicle of named STL parts driving through a generated wading channel: wetting per part, sensors, splash heights.";
-    "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run),
+    "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run), ranks = false,
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";
-    "cfd_dem" => CfdDem(spatter_workflows::cfd_dem::CfdDemConfig, spatter_workflows::cfd_dem::run),
+    "cfd_dem" => CfdDem(spatter_workflows::cfd_dem::CfdDemConfig, spatter_workflows::cfd_dem::run), ranks = false,
         "Flow on a Cartesian grid coupled two-way to a DEM scene (volume-averaged CFD-DEM): fluidised and fixed beds, settling.";
-    "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run),
+    "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run), ranks = false,
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
-    "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run),
+    "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run), ranks = false,
         "Stone-chip test (DIN 55996-1, SAE J400): stones shot through a pipe at a coated panel; damage map, strip shares, impact statistics.";
-    "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run),
+    "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run), ranks = false,
         "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";
-    "integrator_study" => IntegratorStudy(spatter_workflows::bed_lab::IntegratorStudyConfig, spatter_workflows::bed_lab::run_integrator_study),
+    "integrator_study" => IntegratorStudy(spatter_workflows::bed_lab::IntegratorStudyConfig, spatter_workflows::bed_lab::run_integrator_study), ranks = false,
         "The ten DEM time integrators on analytic single contacts: error sweeps, observed orders beside Jasion (2013).";
 }
 

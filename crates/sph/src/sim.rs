@@ -31,10 +31,14 @@ use crate::params::SphParams;
 use crate::pass::{self, Consts, FluidOut, FluidSet, PassStats, WallSet};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::{KinematicTree, Motion};
 use spatter_core::{Aabb, Vec3};
 use std::mem::take;
+
+#[path = "decomp.rs"]
+mod decomp;
 
 /// Wall properties shared by every kind of part.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -176,6 +180,9 @@ pub struct Simulation {
     initialized: bool,
     #[serde(skip)]
     work: Work,
+    /// This rank's share of space when the run is split over several ranks (None on one rank).
+    #[serde(skip)]
+    decomp: Option<decomp::Decomp>,
 }
 
 impl Simulation {
@@ -198,6 +205,7 @@ impl Simulation {
             flux_down: Vec::new(),
             initialized: false,
             work: Work::default(),
+            decomp: None,
         }
     }
 
@@ -375,15 +383,17 @@ impl Simulation {
     /// Prepares the run: wall volumes, placement at the current time, the first force evaluation and
     /// time step. Call once after set-up.
     pub fn initialize(&mut self) -> Result<(), SphError> {
-        if self.fluid.is_empty() {
+        self.initialize_with(&SERIAL)
+    }
+
+    /// [`Self::initialize`] on the ranks of `comm`. With several ranks every rank holds the same set-up
+    /// (built the same way on each); the fluid is then split by recursive coordinate bisection and each
+    /// rank keeps the particles in its box (see [`Self::step_with`]). Collective: call on every rank.
+    pub fn initialize_with(&mut self, comm: &dyn Comm) -> Result<(), SphError> {
+        if self.decomp.is_none() && self.fluid.is_empty() {
             return Err(SphError::Setup("no fluid particles: fill a region or add particles".into()));
         }
-        if self.domain.is_empty() {
-            let mut b = Aabb::from_points(&self.fluid.pos).union(Aabb::from_points(&self.boundary.ref_pos));
-            let margin = (0.1 * b.extent().max_element()).max(10.0 * self.params.spacing);
-            b = b.inflated(margin);
-            self.domain = b;
-        }
+        self.default_domain();
         for a in 0..3 {
             if self.periodic[a] {
                 let len = self.domain.max[a] - self.domain.min[a];
@@ -402,14 +412,32 @@ impl Simulation {
             self.flux_up = vec![0.0; self.flux_planes.len()];
             self.flux_down = vec![0.0; self.flux_planes.len()];
         }
-        self.prepare_sets();
+        if comm.size() > 1 {
+            self.decompose(comm)?;
+        }
+        self.prepare_sets_with(comm);
         let st = self.passes(0.0);
         let n = self.fluid.len();
         self.fluid.acc[..n].copy_from_slice(&self.work.acc_new[..n]);
         self.fluid.drho[..n].copy_from_slice(&self.work.drho_new[..n]);
-        self.update_dt(st);
+        if self.decomp.is_some() {
+            self.reduce_step(comm, st, decomp::LocalCounts::default())?;
+        } else {
+            self.update_dt(st);
+        }
         self.initialized = true;
         Ok(())
+    }
+
+    /// Without a domain box: the box around the fluid and the walls, widened by a tenth of its largest
+    /// extent (at least ten spacings).
+    fn default_domain(&mut self) {
+        if self.domain.is_empty() {
+            let mut b = Aabb::from_points(&self.fluid.pos).union(Aabb::from_points(&self.boundary.ref_pos));
+            let margin = (0.1 * b.extent().max_element()).max(10.0 * self.params.spacing);
+            b = b.inflated(margin);
+            self.domain = b;
+        }
     }
 
     /// Rebuilds every scratch structure from the state (after loading a checkpoint). Changes no state.
@@ -471,6 +499,11 @@ impl Simulation {
 
     /// Sorts the fluid by cell, computes pressures, periodic images and the wall set.
     fn prepare_sets(&mut self) {
+        self.prepare_sets_with(&SERIAL)
+    }
+
+    /// [`Self::prepare_sets`]; on several ranks the images are the halo received from the neighbours.
+    fn prepare_sets_with(&mut self, comm: &dyn Comm) {
         let support = self.kernel().support();
         let w = &mut self.work;
         w.grid.rebuild(&self.fluid.pos, support);
@@ -488,7 +521,11 @@ impl Simulation {
         // Dry wall particles skip their fluid query.
         w.grid.build_reach();
         self.compute_pressure();
-        self.build_fluid_images();
+        if self.decomp.is_some() {
+            self.exchange_halo(comm);
+        } else {
+            self.build_fluid_images();
+        }
         self.build_wall_set();
         self.work.ready = true;
     }
@@ -510,7 +547,6 @@ impl Simulation {
     /// Images of fluid particles within one support of a periodic face, shifted by the period.
     fn build_fluid_images(&mut self) {
         let support = self.kernel().support();
-        let origin = self.coords_origin();
         let w = &mut self.work;
         w.g_src.clear();
         w.g_pos.clear();
@@ -545,6 +581,14 @@ impl Simulation {
                 }
             }
         }
+        self.sort_images();
+    }
+
+    /// Sorts the images (`g_pos`, `g_src`) by cell and fills in their state.
+    fn sort_images(&mut self) {
+        let support = self.kernel().support();
+        let origin = self.coords_origin();
+        let w = &mut self.work;
         w.g_grid.rebuild(&w.g_pos, support);
         let perm = w.g_grid.entries();
         w.g_tmp_u.clear();
@@ -559,6 +603,10 @@ impl Simulation {
 
     /// Copies velocity, density and pressure of the sources into the images.
     fn gather_image_state(&mut self) {
+        if self.decomp.is_some() {
+            self.gather_halo_state();
+            return;
+        }
         let w = &mut self.work;
         let f = &self.fluid;
         w.g_vel.clear();
@@ -794,12 +842,14 @@ impl Simulation {
     }
 
     fn update_dt(&mut self, st: PassStats) {
-        let p = &self.params;
-        let h = p.h();
-        let eos = p.eos();
+        let (vmax2, rmax, rmin) = self.local_extrema();
+        self.set_dt(vmax2, rmax, rmin, st);
+    }
+
+    /// Largest squared speed, largest and smallest density of this rank's fluid.
+    fn local_extrema(&self) -> (f64, f64, f64) {
         // Maxima and minima do not depend on the order: reduced in parallel.
-        let (vmax, rmax, rmin) = self
-            .fluid
+        self.fluid
             .vel
             .par_iter()
             .zip(self.fluid.rho.par_iter())
@@ -808,8 +858,15 @@ impl Simulation {
                 || (0.0f64, 0.0f64, f64::INFINITY),
                 |(vm, rx, rn), (v, &r)| (vm.max(v.length_squared()), rx.max(r), rn.min(r)),
             )
-            .reduce(|| (0.0f64, 0.0f64, f64::INFINITY), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));
-        let vmax = vmax.sqrt();
+            .reduce(|| (0.0f64, 0.0f64, f64::INFINITY), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)))
+    }
+
+    /// The next time step from the largest squared speed, the density range and the pass statistics.
+    fn set_dt(&mut self, vmax2: f64, rmax: f64, rmin: f64, st: PassStats) {
+        let p = &self.params;
+        let h = p.h();
+        let eos = p.eos();
+        let vmax = vmax2.sqrt();
         let cmax = eos.sound_speed(rmax.max(p.rest_density));
         let vwall = self.boundary.max_speed();
         let dt_a = p.cfl * h / (cmax + vmax + vwall);
@@ -851,7 +908,32 @@ impl Simulation {
                 d
             }
         };
-        // Predictor and drift.
+        self.predict(dt);
+        self.work.times.predict += lap();
+        // Walls move to the new time; the guard stops crossings.
+        self.work.frames_old.clear();
+        self.work.frames_old.extend_from_slice(&self.boundary.frames);
+        self.count_flux();
+        self.boundary.update_kinematics(&self.tree, t1);
+        self.last.guard_hits = self.guard();
+        self.wrap_and_remove()?;
+        self.work.times.walls_guard += lap();
+        // Forces at the new positions.
+        self.prepare_sets();
+        self.work.times.sort += lap();
+        let st = self.passes_timed(dt, &mut lap);
+        self.accumulate_wetting(dt);
+        self.correct(dt);
+        self.time = t1;
+        self.steps += 1;
+        self.update_dt(st);
+        self.last.dt_taken = dt;
+        self.work.times.correct += lap();
+        Ok(())
+    }
+
+    /// Predictor and drift: `x ← x + dt (v + ½dt a) + shift`, `v* = v + dt a`, `ρ* = ρ + dt Dρ`.
+    fn predict(&mut self, dt: f64) {
         {
             let f = &mut self.fluid;
             let shift = &f.shift;
@@ -871,21 +953,10 @@ impl Simulation {
                     *rho += d * dt;
                 });
         }
-        self.work.times.predict += lap();
-        // Walls move to the new time; the guard stops crossings.
-        self.work.frames_old.clear();
-        self.work.frames_old.extend_from_slice(&self.boundary.frames);
-        self.count_flux();
-        self.boundary.update_kinematics(&self.tree, t1);
-        self.last.guard_hits = self.guard();
-        self.wrap_and_remove()?;
-        self.work.times.walls_guard += lap();
-        // Forces at the new positions.
-        self.prepare_sets();
-        self.work.times.sort += lap();
-        let st = self.passes_timed(dt, &mut lap);
-        self.accumulate_wetting(dt);
-        // Corrector.
+    }
+
+    /// Corrector: `v ← v* + ½dt (a' − a)`, `ρ ← ρ* + ½dt (Dρ' − Dρ)`, and the new rates become current.
+    fn correct(&mut self, dt: f64) {
         {
             let w = &self.work;
             let f = &mut self.fluid;
@@ -903,12 +974,6 @@ impl Simulation {
                 },
             );
         }
-        self.time = t1;
-        self.steps += 1;
-        self.update_dt(st);
-        self.last.dt_taken = dt;
-        self.work.times.correct += lap();
-        Ok(())
     }
 
     /// Applies the crossing guard to every particle that was near a wall; returns how many were stopped.
@@ -1038,17 +1103,7 @@ impl Simulation {
             } else {
                 "density"
             };
-            return Err(SphError::BlowUp {
-                step: self.steps + 1,
-                time: self.time + self.dt,
-                id: self.fluid.id[i],
-                what,
-                cause: format!(
-                    "the time step ({:.3e} s) is too large for the forces, or the sound speed ({} m/s) is below \
-                     10× the flow speed; lower `cfl` or raise the sound speed",
-                    self.dt, self.params.sound_speed
-                ),
-            });
+            return Err(self.blow_up(self.fluid.id[i], what, self.steps + 1, self.time + self.dt, self.dt));
         }
         if periodic {
             pos.par_iter_mut().with_min_len(4096).for_each(wrap);
@@ -1069,11 +1124,28 @@ impl Simulation {
         Ok(())
     }
 
+    /// The error for fluid particle `id` found with a non-finite `what` in step `step` (time `time`,
+    /// time step `dt`).
+    fn blow_up(&self, id: u32, what: &'static str, step: u64, time: f64, dt: f64) -> SphError {
+        SphError::BlowUp {
+            step,
+            time,
+            id,
+            what,
+            cause: format!(
+                "the time step ({dt:.3e} s) is too large for the forces, or the sound speed ({} m/s) is below \
+                 10× the flow speed; lower `cfl` or raise the sound speed",
+                self.params.sound_speed
+            ),
+        }
+    }
+
     fn accumulate_wetting(&mut self, dt: f64) {
+        let decomp = self.decomp.as_ref();
         let w = &self.work;
         let b = &mut self.boundary;
         for k in 0..w.w_src.len() {
-            if w.w_ghost[k] {
+            if w.w_ghost[k] || decomp.is_some_and(|d| !d.owns(w.w_pos[k])) {
                 continue;
             }
             let s = w.w_src[k] as usize;
@@ -1108,8 +1180,10 @@ impl Simulation {
             .enumerate()
             .map(|(k, p)| self.boundary.frames[k].to_world(p.torque_point))
             .collect();
+        let decomp = self.decomp.as_ref();
         for k in 0..w.w_src.len() {
-            if w.w_ghost[k] {
+            // On several ranks each rank adds the entries in its box (summed by `part_loads_with`).
+            if w.w_ghost[k] || decomp.is_some_and(|d| !d.owns(w.w_pos[k])) {
                 continue;
             }
             let part = w.w_part[k] as usize;
@@ -1135,15 +1209,23 @@ impl Simulation {
     /// Mean extrapolated wall pressure \[Pa\] of the first-layer wall particles within `radius` of `x`
     /// (a wall pressure sensor), or None when none is in range. Uses the state of the last step.
     pub fn wall_pressure(&mut self, x: Vec3, radius: f64) -> Option<f64> {
+        let (s, n) = self.wall_pressure_sum(x, radius);
+        (n > 0).then(|| s / n as f64)
+    }
+
+    /// Sum of the extrapolated pressures \[Pa\] and number of the first-layer wall entries within
+    /// `radius` of `x` (on several ranks: of the entries in this rank's box).
+    fn wall_pressure_sum(&mut self, x: Vec3, radius: f64) -> (f64, usize) {
         if !self.work.ready {
             self.refresh();
         }
         let w = &self.work;
         let eos = self.params.eos();
+        let decomp = self.decomp.as_ref();
         let (mut s, mut n) = (0.0, 0usize);
         for k in 0..w.w_src.len() {
             let src = w.w_src[k] as usize;
-            if w.w_ghost[k] || self.boundary.area[src] <= 0.0 {
+            if w.w_ghost[k] || self.boundary.area[src] <= 0.0 || decomp.is_some_and(|d| !d.owns(w.w_pos[k])) {
                 continue;
             }
             if (w.w_pos[k] - x).length() <= radius {
@@ -1151,7 +1233,7 @@ impl Simulation {
                 n += 1;
             }
         }
-        (n > 0).then(|| s / n as f64)
+        (s, n)
     }
 
     /// Total kinetic energy of the fluid \[J, J/m in 2D\].

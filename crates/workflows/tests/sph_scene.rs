@@ -519,3 +519,65 @@ fn adhesion_outside_the_calibrated_range_is_warned_about() {
         );
     }
 }
+
+/// The small dam break split over 2 and 3 thread-ranks against one rank: the same series, wet areas and
+/// splash heights within 10⁻⁶ of each column's scale (the runs differ at the single-precision rounding of
+/// the pairs across rank cuts; see `spatter-sph`'s `tests/decomposed.rs`), the same particle count in
+/// every row (exact); every output holds one `.pvtu` naming one piece per rank, the pieces hold every
+/// particle once, and the walls are written once.
+#[test]
+fn a_run_on_ranks_matches_one_rank() {
+    use spatter_core::comm::ThreadComm;
+    let text = SMALL.replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwall_particles = true");
+    let cfg = config(&text);
+    let tmp = tempfile::tempdir().unwrap();
+    let one = tmp.path().join("one");
+    run_to_end(&cfg, &one);
+    let (cols, rows1) = spatter_io::csv::read_series(&one.join("series.csv")).unwrap();
+    for n in [2usize, 3] {
+        let out = tmp.path().join(format!("ranks{n}"));
+        let d = RunDir::create(&out).unwrap();
+        let done = ThreadComm::run(n, |comm| {
+            let ctx = RunContext { dir: &d, control: &Unattended, resume: false, input_hash: 0, comm };
+            run(&cfg, &ctx).map(|s| s.finished).map_err(|e| e.to_string())
+        });
+        assert!(done.iter().all(|f| *f == Ok(Finished::Completed)), "{done:?}");
+        let (cols_n, rows) = spatter_io::csv::read_series(&out.join("series.csv")).unwrap();
+        assert_eq!(cols_n, cols);
+        assert_eq!(rows.len(), rows1.len());
+        for (c, name) in cols.iter().enumerate() {
+            let col = |rs: &Vec<Vec<f64>>| rs.iter().map(|r| r[c]).collect::<Vec<f64>>();
+            let (a, b) = (col(&rows1), col(&rows));
+            let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+            let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            if name == "particles" || name == "step" {
+                assert_eq!(worst, 0.0, "{n} ranks, column {name}");
+            }
+            assert!(worst <= 1e-6 * scale, "{n} ranks, column {name}: off by {worst:e} of {scale:e}");
+        }
+        for table in ["wetting.csv", "splash_height.csv"] {
+            let t1 = std::fs::read_to_string(one.join(table)).unwrap();
+            let tn = std::fs::read_to_string(out.join(table)).unwrap();
+            let nums =
+                |t: &str| -> Vec<f64> { t.split([',', '\n']).filter_map(|v| v.parse().ok()).collect() };
+            let (a, b) = (nums(&t1), nums(&tn));
+            assert_eq!(a.len(), b.len(), "{table}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-9), "{n} ranks, {table}: {y} vs {x}");
+            }
+        }
+        let pvtu = std::fs::read_to_string(out.join("particles/particles_00005.pvtu")).unwrap();
+        let mut total = 0;
+        for r in 0..n {
+            let piece = format!("particles_00005_r{r:04}.vtu");
+            assert!(pvtu.contains(&format!("Source=\"{piece}\"")), "{pvtu}");
+            total += spatter_io::vtk::read(&out.join("particles").join(&piece)).unwrap().points.len();
+        }
+        assert_eq!(total, 10 * 20, "every particle in one piece");
+        let pvd = std::fs::read_to_string(out.join("particles.pvd")).unwrap();
+        assert!(pvd.contains("particles/particles_00005.pvtu"), "{pvd}");
+        assert!(out.join("walls.vtu").is_file() && out.join("walls/walls_00005.vtu").is_file());
+        let stray: Vec<_> = std::fs::read_dir(out.join("walls")).unwrap().filter_map(|e| e.ok()).collect();
+        assert_eq!(stray.len(), 6, "one walls file per output");
+    }
+}

@@ -1,6 +1,7 @@
 //! Turns a validated [`SphConfig`] into a ready [`Simulation`].
 
 use super::config::{axis_index, face_index, FillType, SphConfig, WallType};
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::mesh::TriMesh;
 use spatter_core::{Aabb, Vec3};
 use spatter_sph::error::SphError;
@@ -25,6 +26,12 @@ pub struct BuildInfo {
 
 /// Builds the simulation (file paths as given: the scenario loader has made them absolute).
 pub fn build(cfg: &SphConfig) -> Result<(Simulation, BuildInfo), SphError> {
+    build_with(cfg, &SERIAL)
+}
+
+/// [`build`] on the ranks of `comm`: every rank builds the whole set-up the same way, then keeps the
+/// fluid in its box (see [`Simulation::initialize_with`]); the counts in [`BuildInfo`] are the whole run's.
+pub fn build_with(cfg: &SphConfig, comm: &dyn Comm) -> Result<(Simulation, BuildInfo), SphError> {
     let f = &cfg.fluid;
     let dim = if f.dimensions == 2 { Dim::Two } else { Dim::Three };
     let dp = f.spacing_m;
@@ -231,7 +238,6 @@ pub fn build(cfg: &SphConfig) -> Result<(Simulation, BuildInfo), SphError> {
     if let Some(h) = &cfg.sensors.height {
         sim.set_flux_planes((0..=h.bins).map(|k| h.base_z_m + k as f64 * h.bin_m).collect());
     }
-    sim.initialize()?;
     let info = BuildInfo {
         u_max,
         sound_speed: c0,
@@ -239,5 +245,6 @@ pub fn build(cfg: &SphConfig) -> Result<(Simulation, BuildInfo), SphError> {
         wall_particles: sim.boundary.len(),
         warnings,
     };
+    sim.initialize_with(comm)?;
     Ok((sim, info))
 }

@@ -1,8 +1,14 @@
 //! Running an `sph` scenario: time loop, outputs, checkpoint and resume.
+//!
+//! On several ranks (`ctx.comm`, a run under `mpirun`) every rank steps its share of the fluid and joins
+//! every collective sensor; rank 0 alone writes `series.csv`, the `.pvd`, the `.pvtu` of each output, the
+//! walls, maps and tables; every rank writes its own piece of the particle output. Such runs write no
+//! checkpoint yet.
 
-use super::build::{build, BuildInfo};
+use super::build::{build_with, BuildInfo};
 use super::config::SphConfig;
 use serde::{Deserialize, Serialize};
+use spatter_core::comm::Comm;
 use spatter_core::control::Finished;
 use spatter_core::Vec3;
 use spatter_io::csv::{write_table, CsvSeries};
@@ -70,17 +76,18 @@ fn series_columns(cfg: &SphConfig, sim: &Simulation) -> Vec<String> {
     c
 }
 
-/// One row of `series.csv`; a probe without fluid around it is a gap (`None`).
-fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<Option<f64>> {
+/// One row of `series.csv`; a probe without fluid around it is a gap (`None`). Collective: every rank
+/// computes the same row.
+fn series_row(cfg: &SphConfig, sim: &mut Simulation, comm: &dyn Comm) -> Vec<Option<f64>> {
     let l = sim.last;
     let mut r: Vec<Option<f64>> = [
         sim.time,
         sim.dt,
         sim.steps as f64,
-        sim.fluid.len() as f64,
+        sim.fluid_count_with(comm) as f64,
         sim.removed.outside_domain as f64,
         sim.removed.density_window as f64,
-        sim.kinetic_energy(),
+        sim.kinetic_energy_with(comm),
         l.max_speed,
         l.max_density_ratio,
         l.min_density_ratio,
@@ -90,26 +97,26 @@ fn series_row(cfg: &SphConfig, sim: &mut Simulation) -> Vec<Option<f64>> {
     ]
     .map(Some)
     .to_vec();
-    let loads = sim.part_loads();
+    let loads = sim.part_loads_with(comm);
     for (k, ld) in loads.iter().enumerate() {
-        let wa = wet_area(sim, k, sim.time);
+        let wa = sim.wet_area_with(comm, k, sim.time);
         r.extend(
             [ld.force.x, ld.force.y, ld.force.z, ld.torque.x, ld.torque.y, ld.torque.z, wa.wet_now].map(Some),
         );
     }
     for p in &cfg.sensors.probes {
-        match sim.probe(p.position_m) {
+        match sim.probe_with(comm, p.position_m) {
             Some((pr, v)) => r.extend([pr, v.x, v.y, v.z].map(Some)),
             None => r.extend([None; 4]),
         }
     }
     for p in &cfg.sensors.wall_probes {
-        r.push(sim.wall_pressure(p.position_m, p.radius_m));
+        r.push(sim.wall_pressure_with(comm, p.position_m, p.radius_m));
     }
     r
 }
 
-fn write_particles(dir: &Path, rel: &str, cfg: &SphConfig, sim: &Simulation) -> std::io::Result<()> {
+fn particles_vtu(cfg: &SphConfig, sim: &Simulation) -> Vtu {
     let base = cfg.sensors.height.as_ref().map(|h| h.base_z_m).unwrap_or(0.0);
     let f = &sim.fluid;
     let height: Vec<f64> = f.pos.iter().map(|p| p.z - base).collect();
@@ -120,13 +127,42 @@ fn write_particles(dir: &Path, rel: &str, cfg: &SphConfig, sim: &Simulation) -> 
         .point_scalar("density_kg_m3", &f.rho)
         .point_scalar("height_m", &height)
         .point_int("id", &ids)
-        .write(&dir.join(rel))
 }
 
-fn write_walls(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+/// Writes the particle output number `count`; returns its path relative to the run folder (for the
+/// `.pvd`). One rank: `particles/particles_00012.vtu`. Several: every rank writes its piece
+/// `particles/particles_00012_r0003.vtu` and rank 0 the `particles/particles_00012.pvtu` joining them.
+fn write_particles(
+    dir: &spatter_io::run::RunDir,
+    count: u32,
+    cfg: &SphConfig,
+    sim: &Simulation,
+    comm: &dyn Comm,
+) -> Result<String, SphError> {
+    let vtu = particles_vtu(cfg, sim);
+    if comm.size() == 1 {
+        let rel = format!("particles/particles_{count:05}.vtu");
+        let p = dir.path(&rel);
+        vtu.write(&p).map_err(io_at(&p))?;
+        return Ok(rel);
+    }
+    let piece = |r: usize| format!("particles_{count:05}_r{r:04}.vtu");
+    let p = dir.path(&format!("particles/{}", piece(comm.rank())));
+    vtu.write(&p).map_err(fatal(comm, &p))?;
+    let rel = format!("particles/particles_{count:05}.pvtu");
+    if comm.is_root() {
+        let p = dir.path(&rel);
+        let pieces: Vec<String> = (0..comm.size()).map(piece).collect();
+        vtu.write_pvtu(&p, &pieces).map_err(io_at(&p))?;
+    }
+    Ok(rel)
+}
+
+/// The wall particles with the wetting records `wet`, `wet_time` (gathered from every rank).
+fn write_walls(path: &Path, sim: &Simulation, (wet, wet_time): (&[bool], &[f64])) -> std::io::Result<()> {
     let b = &sim.boundary;
     let part: Vec<i64> = b.part.iter().map(|&p| p as i64).collect();
-    let wet: Vec<i64> = b.wet.iter().map(|&w| w as i64).collect();
+    let wet: Vec<i64> = wet.iter().map(|&w| w as i64).collect();
     let n = b.len();
     let pos: Vec<Vec3> = (0..n).map(|i| b.position(i)).collect();
     let vel: Vec<Vec3> = (0..n).map(|i| b.velocity(i)).collect();
@@ -136,7 +172,7 @@ fn write_walls(path: &Path, sim: &Simulation) -> std::io::Result<()> {
         .point_vector("normal", &nrm)
         .point_scalar("area_m2", &b.area)
         .point_scalar("volume_m3", &b.volume)
-        .point_scalar("wet_time_s", &b.wet_time)
+        .point_scalar("wet_time_s", wet_time)
         .point_int("wet", &wet)
         .point_int("part", &part)
         .write(path)
@@ -146,15 +182,37 @@ fn io_at(path: &Path) -> impl Fn(std::io::Error) -> SphError + '_ {
     move |e| SphError::Io(std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }
 
+/// A write that failed on one rank of several: the others cannot be told in a collective they are not
+/// in, so the whole run ends here (after printing the error); on one rank an ordinary error.
+fn fatal<'a>(comm: &'a dyn Comm, path: &'a Path) -> impl Fn(std::io::Error) -> SphError + 'a {
+    move |e| {
+        let e = io_at(path)(e);
+        if comm.size() > 1 {
+            eprintln!("error on rank {} of {}: {e}; ending the run", comm.rank(), comm.size());
+            comm.abort(1);
+        }
+        e
+    }
+}
+
 /// Runs the scenario in `ctx` (see `docs/sph.md` for the files written). File paths are taken as given
 /// (the scenario loader has made them absolute; see [`spatter_io::paths`]).
 pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
     let dir = ctx.dir;
-    let root = dir.root().to_owned();
+    let comm = ctx.comm;
+    let (root, ranks) = (comm.is_root(), comm.size() > 1);
     let ckpt = dir.checkpoint_path();
     let series_path = dir.path("series.csv");
     let pvd_path = dir.path("particles.pvd");
     let session = Instant::now();
+    if ranks && ctx.resume {
+        return Err(SphError::Setup(format!(
+            "resuming on {} ranks is not possible yet (runs on several ranks write no checkpoint); resume \
+             without mpirun",
+            comm.size()
+        )));
+    }
+    // Rank 0 alone writes the series and the .pvd.
     let (mut st, mut series, mut pvd) = if ctx.resume && ckpt.exists() {
         let mut st: SceneState = ctx.load_checkpoint()?;
         st.sim.refresh();
@@ -164,28 +222,35 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
         let mut pvd = PvdSeries::load_or_new(&pvd_path).map_err(io_at(&pvd_path))?;
         pvd.truncate_after(st.sim.time).map_err(io_at(&pvd_path))?;
         tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
-        (st, series, pvd)
+        (st, Some(series), Some(pvd))
     } else {
-        let (sim, info) = build(cfg)?;
-        tracing::info!(
-            "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s)",
-            cfg.title,
-            info.fluid_particles,
-            info.wall_particles,
-            sim.params.spacing,
-            sim.params.h(),
-            info.u_max,
-            info.sound_speed,
-            sim.dt,
-            rayon::current_num_threads()
-        );
-        for w in &info.warnings {
-            tracing::warn!("{w}");
+        let (sim, info) = build_with(cfg, comm)?;
+        if root {
+            tracing::info!(
+                "sph {}: {} fluid and {} wall particles, dp = {} m, h = {:.4} m, U_max = {:.4} m/s, c0 = {:.4} m/s, dt0 = {:.4e} s, {} thread(s){}",
+                cfg.title,
+                info.fluid_particles,
+                info.wall_particles,
+                sim.params.spacing,
+                sim.params.h(),
+                info.u_max,
+                info.sound_speed,
+                sim.dt,
+                rayon::current_num_threads(),
+                if ranks { format!(" on each of {} ranks", comm.size()) } else { String::new() }
+            );
+            for w in &info.warnings {
+                tracing::warn!("{w}");
+            }
         }
-        let cols = series_columns(cfg, &sim);
-        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
-        let series = CsvSeries::create(&series_path, &cols).map_err(io_at(&series_path))?;
-        let pvd = PvdSeries::new(&pvd_path);
+        let (series, pvd) = if root {
+            let cols = series_columns(cfg, &sim);
+            let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+            let series = CsvSeries::create(&series_path, &cols).map_err(fatal(comm, &series_path))?;
+            (Some(series), Some(PvdSeries::new(&pvd_path)))
+        } else {
+            (None, None)
+        };
         let nb = cfg.sensors.height.as_ref().map(|h| h.bins).unwrap_or(0);
         let st = SceneState {
             sim,
@@ -202,8 +267,11 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
             wall_seconds: 0.0,
         };
         if cfg.output.wall_particles {
+            let wetting = st.sim.wetting_with(comm);
             let p = dir.path("walls.vtu");
-            write_walls(&p, &st.sim).map_err(io_at(&p))?;
+            if root {
+                write_walls(&p, &st.sim, (&wetting.0, &wetting.1)).map_err(fatal(comm, &p))?;
+            }
         }
         (st, series, pvd)
     };
@@ -211,49 +279,57 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
     let vtu_dt = cfg.output.vtu_interval();
     let sample_dt = cfg.output.sample_interval();
     let total_steps_estimate = (end / st.sim.dt.max(1e-12)) as u64;
+    let mut checkpoint_skipped = false;
     loop {
         // Outputs due at the current time.
         if st.sim.time >= st.next_sample - 1e-12 * end {
-            let row = series_row(cfg, &mut st.sim);
-            series.row_with_gaps(&row).map_err(io_at(&series_path))?;
+            let row = series_row(cfg, &mut st.sim, comm);
+            if let Some(series) = series.as_mut() {
+                series.row_with_gaps(&row).map_err(fatal(comm, &series_path))?;
+            }
             while st.next_sample <= st.sim.time + 1e-12 * end {
                 st.next_sample += sample_dt;
             }
         }
         if st.sim.time >= st.next_vtu - 1e-12 * end {
-            let rel = format!("particles/particles_{:05}.vtu", st.vtu_count);
-            dir.path(&rel);
-            write_particles(&root, &rel, cfg, &st.sim).map_err(io_at(&root.join(&rel)))?;
-            pvd.push(st.sim.time, &rel).map_err(io_at(&pvd_path))?;
+            let rel = write_particles(dir, st.vtu_count, cfg, &st.sim, comm)?;
+            if let Some(pvd) = pvd.as_mut() {
+                pvd.push(st.sim.time, &rel).map_err(fatal(comm, &pvd_path))?;
+            }
             if cfg.output.wall_particles {
-                let wrel = format!("walls/walls_{:05}.vtu", st.vtu_count);
-                let p = dir.path(&wrel);
-                write_walls(&p, &st.sim).map_err(io_at(&p))?;
+                let wetting = st.sim.wetting_with(comm);
+                let p = dir.path(&format!("walls/walls_{:05}.vtu", st.vtu_count));
+                if root {
+                    write_walls(&p, &st.sim, (&wetting.0, &wetting.1)).map_err(fatal(comm, &p))?;
+                }
             }
             st.vtu_count += 1;
             let l = st.sim.last;
-            tracing::info!(
-                "t = {:.6} s, step {}, dt = {:.4e} s (acoustic {:.3e}, force {:.3e}, viscous {:.3e}), {} particles, removed {} (domain) + {} (density), max speed {:.4} m/s, density {:.4}–{:.4} ρ0, guard stops {}",
-                st.sim.time,
-                st.sim.steps,
-                st.sim.dt,
-                l.dt_acoustic,
-                l.dt_force,
-                l.dt_viscous,
-                st.sim.fluid.len(),
-                st.sim.removed.outside_domain,
-                st.sim.removed.density_window,
-                l.max_speed,
-                l.min_density_ratio,
-                l.max_density_ratio,
-                l.guard_hits
-            );
-            if l.max_speed > 0.1 * st.sim.params.sound_speed {
-                tracing::warn!(
-                    "max speed {:.4} m/s exceeds c0/10 = {:.4} m/s; density errors may exceed 1 % — raise fluid.max_velocity_m_s",
+            let particles = st.sim.fluid_count_with(comm);
+            if root {
+                tracing::info!(
+                    "t = {:.6} s, step {}, dt = {:.4e} s (acoustic {:.3e}, force {:.3e}, viscous {:.3e}), {} particles, removed {} (domain) + {} (density), max speed {:.4} m/s, density {:.4}–{:.4} ρ0, guard stops {}",
+                    st.sim.time,
+                    st.sim.steps,
+                    st.sim.dt,
+                    l.dt_acoustic,
+                    l.dt_force,
+                    l.dt_viscous,
+                    particles,
+                    st.sim.removed.outside_domain,
+                    st.sim.removed.density_window,
                     l.max_speed,
-                    0.1 * st.sim.params.sound_speed
+                    l.min_density_ratio,
+                    l.max_density_ratio,
+                    l.guard_hits
                 );
+                if l.max_speed > 0.1 * st.sim.params.sound_speed {
+                    tracing::warn!(
+                        "max speed {:.4} m/s exceeds c0/10 = {:.4} m/s; density errors may exceed 1 % — raise fluid.max_velocity_m_s",
+                        l.max_speed,
+                        0.1 * st.sim.params.sound_speed
+                    );
+                }
             }
             while st.next_vtu <= st.sim.time + 1e-12 * end {
                 st.next_vtu += vtu_dt;
@@ -262,33 +338,62 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
         if st.sim.time >= end - 1e-12 * end {
             break;
         }
-        let stop = ctx.control.stop_requested();
-        if stop || ctx.checkpoint_due() {
-            series.flush().map_err(io_at(&series_path))?;
-            st.series_bytes = series.bytes_written();
-            // The checkpoint holds the wall time up to now; this session's count goes on from here.
-            let earlier = st.wall_seconds;
-            st.wall_seconds += session.elapsed().as_secs_f64();
-            ctx.save_checkpoint(&st)?;
-            if stop {
-                tracing::info!(
-                    "stopped at t = {:.6} s, step {}; checkpoint written",
-                    st.sim.time,
-                    st.sim.steps
+        if ranks {
+            // A stop request reaches the ranks at different moments: any rank's request stops all of them
+            // after the same step. No checkpoint on several ranks yet.
+            let mut stop = [if ctx.control.stop_requested() { 1.0 } else { 0.0 }];
+            comm.all_max_f64(&mut stop);
+            if root && !checkpoint_skipped && ctx.checkpoint_due() {
+                tracing::warn!(
+                    "runs on {} ranks write no checkpoint yet; periodic checkpoints are skipped",
+                    comm.size()
                 );
+                checkpoint_skipped = true;
+            }
+            if stop[0] > 0.0 {
+                if let Some(series) = series.as_mut() {
+                    series.flush().map_err(fatal(comm, &series_path))?;
+                }
                 let mut s = RunSummary::new(Finished::Interrupted);
-                s.headline
-                    .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
-                s.artifacts.push(("checkpoint".into(), ckpt));
+                s.headline.push(format!(
+                    "stopped at t = {:.6} s of {end} s; runs on several ranks write no checkpoint yet, so this one \
+                     cannot be resumed",
+                    st.sim.time
+                ));
                 return Ok(s);
             }
-            st.wall_seconds = earlier;
+        } else {
+            let stop = ctx.control.stop_requested();
+            if stop || ctx.checkpoint_due() {
+                let series = series.as_mut().expect("one rank writes the series");
+                series.flush().map_err(io_at(&series_path))?;
+                st.series_bytes = series.bytes_written();
+                // The checkpoint holds the wall time up to now; this session's count goes on from here.
+                let earlier = st.wall_seconds;
+                st.wall_seconds += session.elapsed().as_secs_f64();
+                ctx.save_checkpoint(&st)?;
+                if stop {
+                    tracing::info!(
+                        "stopped at t = {:.6} s, step {}; checkpoint written",
+                        st.sim.time,
+                        st.sim.steps
+                    );
+                    let mut s = RunSummary::new(Finished::Interrupted);
+                    s.headline
+                        .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
+                    s.artifacts.push(("checkpoint".into(), ckpt));
+                    return Ok(s);
+                }
+                st.wall_seconds = earlier;
+            }
         }
-        st.sim.step()?;
+        st.sim.step_with(comm)?;
         accumulate_height(cfg, &mut st);
         ctx.control.progress(st.sim.steps, total_steps_estimate.max(st.sim.steps));
     }
-    series.flush().map_err(io_at(&series_path))?;
+    if let Some(series) = series.as_mut() {
+        series.flush().map_err(fatal(comm, &series_path))?;
+    }
     let wall = st.wall_seconds + session.elapsed().as_secs_f64();
     finish(cfg, ctx, st, wall)
 }
@@ -323,10 +428,28 @@ fn accumulate_height(cfg: &SphConfig, st: &mut SceneState) {
     }
 }
 
-fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Result<RunSummary, SphError> {
+fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> Result<RunSummary, SphError> {
     let dir = ctx.dir;
-    let mut sim = st.sim;
+    let comm = ctx.comm;
+    // The collective part: every rank's share of the loads, particles, wetting, heights and fluxes.
+    let loads = st.sim.part_loads_with(comm);
+    let particles = st.sim.fluid_count_with(comm);
+    st.sim.gather_wetting(comm);
+    for v in [
+        &mut st.height_volume_time,
+        &mut st.flux_up,
+        &mut st.flux_down,
+        &mut st.sim.flux_up,
+        &mut st.sim.flux_down,
+    ] {
+        comm.sum_f64_ordered(v);
+    }
+    let sim = st.sim;
     let mut summary = RunSummary::new(Finished::Completed);
+    if !comm.is_root() {
+        // Rank 0 writes the results and the summary.
+        return Ok(summary);
+    }
     let elapsed = sim.time;
     // Wetting maps and wet areas.
     let mut rows = Vec::new();
@@ -469,24 +592,23 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
     }
     // Cost.
     let threads = rayon::current_num_threads();
+    let (cores, workers) = if comm.size() > 1 {
+        (threads * comm.size(), format!("{} ranks × {threads} thread(s)", comm.size()))
+    } else {
+        (threads, format!("{threads} thread(s)"))
+    };
     let cost = format!(
-        "run cost: {} fluid + {} wall particles, {} steps, {:.1} s wall time, {} thread(s), {:.4} core-hours, {:.3e} particle-steps/s",
-        sim.fluid.len(),
+        "run cost: {} fluid + {} wall particles, {} steps, {:.1} s wall time, {workers}, {:.4} core-hours, {:.3e} particle-steps/s",
+        particles,
         sim.boundary.len(),
         sim.steps,
         wall,
-        threads,
-        wall * threads as f64 / 3600.0,
+        wall * cores as f64 / 3600.0,
         st.info.fluid_particles as f64 * sim.steps as f64 / wall.max(1e-9)
     );
-    let loads = sim.part_loads();
     summary.headline.push(format!(
         "t = {:.4} s in {} steps; {} particles left, {} removed (outside the domain) and {} (density window)",
-        sim.time,
-        sim.steps,
-        sim.fluid.len(),
-        sim.removed.outside_domain,
-        sim.removed.density_window
+        sim.time, sim.steps, particles, sim.removed.outside_domain, sim.removed.density_window
     ));
     for (k, p) in sim.boundary.parts.iter().enumerate() {
         let wa = wet_area(&sim, k, elapsed);
@@ -504,7 +626,7 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, st: SceneState, wall: f64) -> Resul
     for (name, value) in [
         ("t_end_s", sim.time),
         ("steps", sim.steps as f64),
-        ("fluid_particles", sim.fluid.len() as f64),
+        ("fluid_particles", particles as f64),
         ("removed_outside_domain", sim.removed.outside_domain as f64),
         ("removed_density_window", sim.removed.density_window as f64),
     ] {

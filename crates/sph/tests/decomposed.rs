@@ -1,0 +1,384 @@
+//! Runs split over several ranks (threads standing in for MPI ranks, `ThreadComm`) against the same runs
+//! on one rank: particle set and mass exact, momentum balanced across ranks, the flow the same to within
+//! stated tolerances, errors returned by every rank alike (never a hang).
+
+use spatter_core::comm::{Comm, ThreadComm, WireReader, WireWriter};
+use spatter_core::{Aabb, Vec3};
+use spatter_sph::boundary::Slip;
+use spatter_sph::sim::WallOptions;
+use spatter_sph::{Dim, Simulation, SphError, SphParams};
+use std::sync::mpsc;
+use std::time::Duration;
+
+const OPEN_TOP: [bool; 6] = [true, true, true, true, true, false];
+
+/// Runs `f` on `n` thread-ranks and fails the test if they have not all finished within 120 s (a hang in
+/// a collective is a failure, never a stuck test run).
+fn on_ranks<T: Send + 'static>(n: usize, f: impl Fn(&ThreadComm) -> T + Send + Sync + 'static) -> Vec<T> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| ThreadComm::run(n, &f)));
+        let _ = tx.send(out);
+    });
+    match rx.recv_timeout(Duration::from_secs(120)) {
+        Ok(Ok(v)) => v,
+        Ok(Err(e)) => std::panic::resume_unwind(e),
+        Err(_) => panic!("{n} ranks did not finish within 120 s: a collective call hangs"),
+    }
+}
+
+/// The a × 2a water column of Martin & Moyce (1952) in a 6a × 3a open tank, 2D, spacing a/20
+/// (800 particles); the set-up of the `sph_dam_break_surge_front` validation case.
+fn dam_break() -> Simulation {
+    let a: f64 = 0.1;
+    let g: f64 = 9.81;
+    let dp = a / 20.0;
+    let mut p = SphParams::water(Dim::Two, dp, 10.0 * (2.0 * g * 2.0 * a).sqrt());
+    p.gravity = Vec3::new(0.0, 0.0, -g);
+    let mut sim = Simulation::new(p);
+    let tank = Aabb::new(Vec3::ZERO, Vec3::new(6.0 * a, 0.0, 3.0 * a));
+    sim.add_tank("tank", tank, OPEN_TOP, None, None, WallOptions::default());
+    sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(a, 0.0, 2.0 * a)), Vec3::ZERO, true);
+    sim
+}
+
+/// Every rank's (id, position, velocity), gathered on every rank and sorted by id.
+fn gathered(sim: &Simulation, comm: &dyn Comm) -> Vec<(u32, Vec3, Vec3)> {
+    let mut w = WireWriter::with_capacity(52 * sim.fluid.len());
+    for i in 0..sim.fluid.len() {
+        w.u32(sim.fluid.id[i]).vec3(sim.fluid.pos[i]).vec3(sim.fluid.vel[i]);
+    }
+    let mut all = Vec::new();
+    for buf in comm.all_gather_bytes(&w.finish()) {
+        let mut r = WireReader::new(&buf);
+        while !r.is_done() {
+            all.push((r.u32().unwrap(), r.vec3().unwrap(), r.vec3().unwrap()));
+        }
+    }
+    all.sort_by_key(|e| e.0);
+    all
+}
+
+/// Reverses the storage order of the fluid: the same physical set-up whose sums run in another order.
+fn reversed(mut sim: Simulation) -> Simulation {
+    let n = sim.fluid.len();
+    let f = &mut sim.fluid;
+    for v in [&mut f.pos, &mut f.vel, &mut f.acc] {
+        v.reverse();
+    }
+    f.rho.reverse();
+    f.drho.reverse();
+    f.id.reverse();
+    f.near.reverse();
+    f.shift.reverse();
+    assert_eq!(f.len(), n);
+    sim
+}
+
+/// One rank through `step_with` is today's `step`, bit for bit.
+#[test]
+fn one_rank_is_today() {
+    let mut a = dam_break();
+    a.initialize().unwrap();
+    for _ in 0..30 {
+        a.step().unwrap();
+    }
+    let b = on_ranks(1, |comm| {
+        let mut b = dam_break();
+        b.initialize_with(comm).unwrap();
+        for _ in 0..30 {
+            b.step_with(comm).unwrap();
+        }
+        b
+    })
+    .remove(0);
+    assert_eq!(format!("{:?}", a.fluid), format!("{:?}", b.fluid));
+    assert_eq!(a.dt.to_bits(), b.dt.to_bits());
+    assert_eq!(a.last, b.last);
+    assert_eq!(b.ranks(), 1);
+}
+
+/// Surge front (largest x + dp/2) of the dam break every `every` steps up to `steps` on `n` ranks, and
+/// the final positions by id, checking in every step that the gathered id set is the initial one (no
+/// particle lost or doubled) and that every rank holds the same time step.
+fn dam_break_run(n: usize, steps: usize, every: usize) -> (Vec<(f64, f64)>, Vec<Vec3>) {
+    on_ranks(n, move |comm| {
+        let mut sim = dam_break();
+        let total = sim.fluid.len();
+        let dp = sim.params.spacing;
+        sim.initialize_with(comm).unwrap();
+        assert_eq!(sim.ranks(), n);
+        let mut fronts = Vec::new();
+        for s in 1..=steps {
+            sim.step_with(comm).unwrap();
+            let mut dt = [sim.dt, -sim.dt];
+            comm.all_max_f64(&mut dt);
+            assert_eq!(dt[0], -dt[1], "every rank has the same time step");
+            let all = gathered(&sim, comm);
+            assert_eq!(all.len(), total, "particle count (mass) is exact at step {s}");
+            assert!(all.iter().enumerate().all(|(k, e)| e.0 as usize == k), "ids 0..{total} once each");
+            if s % every == 0 {
+                let front = all.iter().map(|e| e.1.x).fold(0.0, f64::max) + 0.5 * dp;
+                fronts.push((sim.time, front));
+            }
+        }
+        (fronts, gathered(&sim, comm).into_iter().map(|e| e.1).collect())
+    })
+    .remove(0)
+}
+
+/// The 2D dam break on 2 and 4 ranks against 1 rank, until the surge has run a column width
+/// (T = t √(2g/a) ≈ 1.6; the Martin & Moyce 1952 set-up). The cuts run through the column and the surge,
+/// so particles and halo cross them all the time. The particle set and count are exact in every step.
+///
+/// Not bit-identical: interior pairs are evaluated in single precision (the batch path) and pairs with
+/// halo particles in double precision (like periodic images), so the runs differ from the first step at
+/// the single-precision rounding of the cut pairs' terms; differences then grow with the flow. Measured
+/// after 1200 steps: 3·10⁻¹¹ m at the front, below 10⁻⁸ m for any particle (any thread count: the engine
+/// is bit-identical across thread counts). The test allows 10⁻⁴ dp = 5·10⁻¹⁰ m at the front and
+/// 10⁻⁵ dp = 5·10⁻⁸ m for any particle. A halo only one support wide (wall entries near a cut then miss
+/// the fluid beyond it) already moves particles by 4·10⁻⁶ m on 2 ranks and 1.6·10⁻⁵ m on 4 in this run.
+#[test]
+fn dam_break_2d_on_1_2_4_ranks() {
+    let (steps, every) = (1200, 100);
+    let dp = 0.005;
+    let (serial, end1) = dam_break_run(1, steps, every);
+    let front_end = serial.last().unwrap().1;
+    assert!(front_end > 0.2, "the surge has run: front at {front_end} m");
+    for n in [2, 4] {
+        let (fronts, end) = dam_break_run(n, steps, every);
+        for (a, b) in serial.iter().zip(&fronts) {
+            assert!((a.0 - b.0).abs() <= 1e-6 * a.0, "{n} ranks: time {} vs {}", b.0, a.0);
+            let d = (a.1 - b.1).abs();
+            assert!(d <= 1e-4 * dp, "{n} ranks at t = {} s: front {} m vs {} m", a.0, b.1, a.1);
+        }
+        let worst = end1.iter().zip(&end).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
+        eprintln!(
+            "dam break, {n} ranks: front differs by {:e} m, worst particle by {worst:e} m",
+            (serial.last().unwrap().1 - fronts.last().unwrap().1).abs()
+        );
+        assert!(worst <= 1e-5 * dp, "{n} ranks: a particle is {worst} m away from its one-rank position");
+    }
+}
+
+/// A free blob with random velocities (no walls, no gravity; the `sph_conservation` validation set-up):
+/// on 2 and 4 ranks the total momentum is conserved to round-off, so the pair forces computed on both
+/// sides of a rank cut are exact opposites.
+#[test]
+fn momentum_balances_across_ranks() {
+    for n in [2, 4] {
+        let dp_rel = on_ranks(n, |comm| {
+            let dp = 0.01;
+            let mut p = SphParams::water(Dim::Three, dp, 20.0);
+            p.gravity = Vec3::ZERO;
+            p.density_window = [0.0, f64::INFINITY];
+            let mut sim = Simulation::new(p);
+            let mut pts = Vec::new();
+            for k in 0..8 {
+                for j in 0..8 {
+                    for i in 0..8 {
+                        pts.push(Vec3::new(i as f64, j as f64, k as f64) * dp);
+                    }
+                }
+            }
+            sim.add_particles(&pts, Vec3::ZERO);
+            let mut rng = spatter_core::rng::seeded(7, 0);
+            use spatter_core::rng::RngExt;
+            for v in &mut sim.fluid.vel {
+                *v = Vec3::new(
+                    rng.random::<f64>() - 0.5,
+                    rng.random::<f64>() - 0.5,
+                    rng.random::<f64>() - 0.5,
+                );
+            }
+            sim.set_domain(Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0)));
+            let m = sim.params.mass();
+            let p0: Vec3 = sim.fluid.vel.iter().copied().sum::<Vec3>() * m;
+            let scale = m * sim.fluid.vel.iter().map(|v| v.length()).sum::<f64>();
+            sim.initialize_with(comm).unwrap();
+            for _ in 0..40 {
+                sim.step_with(comm).unwrap();
+            }
+            let all = gathered(&sim, comm);
+            assert_eq!(all.len(), pts.len());
+            let p1: Vec3 = all.iter().map(|e| e.2).sum::<Vec3>() * m;
+            (p1 - p0).length() / scale
+        });
+        // Same bound as the one-rank `sph_conservation` check: pairwise antisymmetric forces.
+        assert!(dp_rel[0] < 1e-12, "{n} ranks: |ΔP|/Σm|v| = {:e}", dp_rel[0]);
+    }
+}
+
+/// Plug flow at U = 1 cm/s along a channel periodic in x between no-slip plates (10 × 40 particles,
+/// ν = 10⁻⁶ m²/s; a Stokes layer grows from each plate): the bulk moves 15 spacings in 400 steps, through
+/// every cut of 4 ranks along x and across the periodic faces. Every step keeps every id exactly once.
+///
+/// Tolerance: interior pairs are evaluated in single precision (the batch path, relative rounding
+/// ε₃₂ = 1.2·10⁻⁷ per term) and pairs with halo particles in double precision, like periodic images. In
+/// this laminar flow the runs then differ by about ε₃₂ times the largest acceleration (the wall shear
+/// ν U/dp² = 1 m/s²) times the time; the test allows ten times that. Reordering the sums alone (the same
+/// run stored in reverse order) changes velocities by only 10⁻¹¹ m/s, so a missing or doubled halo
+/// neighbour (an O(1) pressure error near a cut) would fail by orders of magnitude.
+#[test]
+fn periodic_shear_crosses_ranks() {
+    let run = |n: usize, reverse: bool| {
+        on_ranks(n, move |comm| {
+            let l = 1e-3;
+            let n_across = 10;
+            let dp = l / n_across as f64;
+            let u = 0.01;
+            let mut p = SphParams::water(Dim::Two, dp, 10.0 * u);
+            p.gravity = Vec3::ZERO;
+            p.artificial_viscosity = 0.0;
+            p.density_diffusion = 0.0;
+            p.kinematic_viscosity = 1e-6;
+            let lx = 40.0 * dp;
+            let mut sim = Simulation::new(p);
+            let layers = sim.default_layers();
+            let thick = layers as f64 * dp;
+            let wall = WallOptions { adhesion: 0.0, slip: Slip::NoSlip };
+            let bottom = Aabb::new(Vec3::new(0.0, 0.0, -thick), Vec3::new(lx, 0.0, 0.0));
+            let top = Aabb::new(Vec3::new(0.0, 0.0, l), Vec3::new(lx, 0.0, l + thick));
+            sim.add_block("bottom", bottom, Some(layers), None, wall);
+            sim.add_block("top", top, Some(layers), None, wall);
+            sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(lx, 0.0, l)), Vec3::new(u, 0.0, 0.0), false);
+            if reverse {
+                sim = reversed(sim);
+            }
+            let total = sim.fluid.len();
+            sim.set_domain(Aabb::new(
+                Vec3::new(0.0, -1.0, -2.0 * thick),
+                Vec3::new(lx, 1.0, l + 2.0 * thick),
+            ));
+            sim.set_periodic(0);
+            sim.initialize_with(comm).unwrap();
+            let mut migrated = [0u64];
+            for s in 0..400 {
+                sim.step_with(comm).unwrap();
+                migrated[0] += sim.exchange_counts().1 as u64;
+                let all = gathered(&sim, comm);
+                assert_eq!(all.len(), total, "step {s}");
+                assert!(all.iter().enumerate().all(|(k, e)| e.0 as usize == k), "ids once each, step {s}");
+            }
+            comm.all_sum_u64(&mut migrated);
+            (gathered(&sim, comm), migrated[0], sim.time)
+        })
+        .remove(0)
+    };
+    let (one, _, t1) = run(1, false);
+    let (rev, _, _) = run(1, true);
+    let (four, migrated, t4) = run(4, false);
+    let env = one.iter().zip(&rev).map(|(a, b)| (a.2 - b.2).length()).fold(0.0, f64::max);
+    let w4 = one.iter().zip(&four).map(|(a, b)| (a.2 - b.2).length()).fold(0.0, f64::max);
+    eprintln!("periodic shear: {migrated} migrations; worst |Δv| 4 ranks {w4:e} m/s, reordered {env:e} m/s");
+    assert!(migrated > 100, "particles crossed the cuts: {migrated} migrations");
+    let (u, nu, dp) = (0.01, 1e-6, 1e-4);
+    let tol = 10.0 * f64::from(f32::EPSILON) * (nu * u / (dp * dp)) * t1;
+    assert!(w4 <= tol, "worst velocity difference {w4:e} m/s > {tol:e} m/s");
+    // The time step follows the largest acceleration, known to the same precision.
+    assert!((t1 - t4).abs() <= 1e-5 * t1, "time after 400 steps: {t4} s vs {t1} s");
+}
+
+/// A particle with a non-finite velocity on one rank: every rank returns the same blow-up error at the
+/// end of the step (no rank left waiting in a collective).
+#[test]
+fn a_blow_up_on_one_rank_stops_every_rank() {
+    let errs = on_ranks(3, |comm| {
+        let mut sim = dam_break();
+        sim.initialize_with(comm).unwrap();
+        sim.step_with(comm).unwrap();
+        if comm.rank() == 1 {
+            let k = sim.fluid.len() / 2;
+            sim.fluid.vel[k] = Vec3::new(f64::NAN, 0.0, 0.0);
+        }
+        let mut out = None;
+        for _ in 0..3 {
+            if let Err(e) = sim.step_with(comm) {
+                out = Some(e.to_string());
+                break;
+            }
+        }
+        out
+    });
+    let first = errs[0].clone().expect("rank 0 reports the blow-up");
+    assert!(first.contains("blow-up") && first.contains("non-finite"), "{first}");
+    assert!(errs.iter().all(|e| e.as_deref() == Some(first.as_str())), "{errs:?}");
+}
+
+/// Set-ups a decomposed run refuses, with the same sentence on every rank: more ranks than particles,
+/// and surface tension.
+#[test]
+fn refusals_are_the_same_on_every_rank() {
+    let errs = on_ranks(8, |comm| {
+        let mut p = SphParams::water(Dim::Two, 0.01, 1.0);
+        p.gravity = Vec3::ZERO;
+        let mut sim = Simulation::new(p);
+        let pts: Vec<Vec3> = (0..5).map(|i| Vec3::new(i as f64 * 0.01, 0.0, 0.0)).collect();
+        sim.add_particles(&pts, Vec3::ZERO);
+        sim.initialize_with(comm).err().map(|e| e.to_string())
+    });
+    let e = errs[0].clone().expect("refused");
+    assert!(e.contains("8 ranks for 5 particles"), "{e}");
+    assert!(errs.iter().all(|x| x.as_deref() == Some(e.as_str())));
+    let errs = on_ranks(2, |comm| {
+        let mut sim = dam_break();
+        sim.params.surface_tension = 0.072;
+        matches!(sim.initialize_with(comm), Err(SphError::Setup(ref s)) if s.contains("surface tension"))
+    });
+    assert_eq!(errs, vec![true, true]);
+}
+
+/// Sensors and totals on 1, 2 and 4 ranks after 200 steps of the dam break: kinetic energy, momentum,
+/// mass, the tank's load, a probe in the column and a wall-pressure sensor on the back wall. Collective
+/// forms (`*_with`) agree with the one-rank plain methods within 10⁻⁶ relative, about ten single-precision
+/// epsilons (the runs differ at the single-precision rounding of cut pairs, see
+/// `dam_break_2d_on_1_2_4_ranks`; measured: up to 3·10⁻⁸ for the wall pressure, 10⁻¹⁰ for the energy); the
+/// mass is exact. An entry counted on two ranks or on none would be off by its whole share.
+#[test]
+fn sensors_agree_across_rank_counts() {
+    let sensors = |n: usize| {
+        on_ranks(n, move |comm| {
+            let mut sim = dam_break();
+            sim.initialize_with(comm).unwrap();
+            for _ in 0..200 {
+                sim.step_with(comm).unwrap();
+            }
+            let load = sim.part_loads_with(comm)[0].force;
+            let (p, v) = sim.probe_with(comm, Vec3::new(0.05, 0.0, 0.05)).unwrap();
+            let pw = sim.wall_pressure_with(comm, Vec3::new(-0.0025, 0.0, 0.03), 0.02).unwrap();
+            let m = sim.momentum_with(comm);
+            [
+                sim.kinetic_energy_with(comm),
+                m.x,
+                m.z,
+                sim.fluid_mass_with(comm),
+                load.x,
+                load.z,
+                p,
+                v.x,
+                v.z,
+                pw,
+            ]
+        })
+        .remove(0)
+    };
+    let one = sensors(1);
+    let names = ["E_kin", "P_x", "P_z", "mass", "F_x", "F_z", "p_probe", "u_probe", "w_probe", "p_wall"];
+    assert!(one[9] > 500.0, "the back-wall sensor is under water: {} Pa", one[9]);
+    for n in [2, 4] {
+        let got = sensors(n);
+        assert_eq!(got[3], one[3], "mass is exact");
+        for k in 0..one.len() {
+            // Momentum and probe velocities are compared against the scale of their largest component.
+            let scale = match k {
+                1 | 2 => one[1].abs().max(one[2].abs()),
+                7 | 8 => one[7].abs().max(one[8].abs()),
+                4 | 5 => one[4].abs().max(one[5].abs()),
+                _ => one[k].abs(),
+            };
+            let rel = (got[k] - one[k]).abs() / scale;
+            eprintln!("{n} ranks {}: {} vs {} (rel {rel:e})", names[k], got[k], one[k]);
+            assert!(rel <= 1e-6, "{n} ranks, {}: {} vs {}", names[k], got[k], one[k]);
+        }
+    }
+}
