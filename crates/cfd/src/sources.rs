@@ -75,6 +75,21 @@ pub enum SourceError {
     NoCells(f64),
 }
 
+/// The accelerations one point force adds to the velocity nodes around it: at most 8 nodes for each of
+/// the 3 components, as (component, padded node index, acceleration \[m/s²\]).
+#[derive(Clone, Copy, Debug)]
+pub struct PointForce {
+    adds: [(u8, usize, f64); 24],
+    len: usize,
+}
+
+impl PointForce {
+    /// The (component, node, acceleration) shares.
+    pub fn nodes(&self) -> &[(u8, usize, f64)] {
+        &self.adds[..self.len]
+    }
+}
+
 impl Flow {
     fn force_arrays(&mut self) -> &mut [Vec<f64>; 3] {
         let n = self.grid.layout.len();
@@ -124,17 +139,29 @@ impl Flow {
     /// accelerations f w/(ρ V_node). In axisymmetric mode `f` is per radian (r, axial, 0). Returns `false`
     /// (and adds nothing) when `x` lies outside the grid.
     pub fn add_point_force(&mut self, x: [f64; 3], f: [f64; 3]) -> bool {
+        match self.point_force_shares(x, f) {
+            Some(shares) => {
+                self.apply_point_force(&shares);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The node accelerations [`Flow::add_point_force`] would add for the force `f` at `x`, without
+    /// adding them (`None` outside the grid). Computing the shares reads the flow only, so many point
+    /// forces can be prepared in parallel and applied in a fixed order with [`Flow::apply_point_force`]
+    /// (the sums are then the same on any thread count).
+    pub fn point_force_shares(&self, x: [f64; 3], f: [f64; 3]) -> Option<PointForce> {
         let g = &self.grid;
         let l = g.layout;
         for a in 0..3 {
             if !(x[a] >= g.axes[a].lo() && x[a] <= g.axes[a].hi()) {
-                return false;
+                return None;
             }
         }
         let rho = self.fluid.density;
-        // At most 8 nodes per component; computed first, then added (no allocation).
-        let mut adds = [(0usize, 0usize, 0.0f64); 24];
-        let mut n_adds = 0;
+        let mut out = PointForce { adds: [(0, 0, 0.0); 24], len: 0 };
         for comp in 0..3 {
             if f[comp] == 0.0 {
                 continue;
@@ -160,15 +187,19 @@ impl Flow {
             }
             for &(c, wt) in &nodes[..count] {
                 let v = g.node_volume(comp, l.coords(c));
-                adds[n_adds] = (comp, c, f[comp] * wt / total / (rho * v));
-                n_adds += 1;
+                out.adds[out.len] = (comp as u8, c, f[comp] * wt / total / (rho * v));
+                out.len += 1;
             }
         }
+        Some(out)
+    }
+
+    /// Adds the node accelerations of one point force (see [`Flow::point_force_shares`]).
+    pub fn apply_point_force(&mut self, shares: &PointForce) {
         let force = self.force_arrays();
-        for &(comp, c, acc) in &adds[..n_adds] {
-            force[comp][c] += acc;
+        for &(comp, c, acc) in shares.nodes() {
+            force[comp as usize][c] += acc;
         }
-        true
     }
 
     /// Total force the body-force field exerts on the fluid, Σ ρ V a over the active nodes \[N\] (per
@@ -176,15 +207,17 @@ impl Flow {
     pub fn total_body_force(&self) -> [f64; 3] {
         let Some(force) = &self.force else { return [0.0; 3] };
         let l = self.grid.layout;
-        let mut out = [0.0; 3];
-        for (a, o) in out.iter_mut().enumerate() {
-            for c in 0..l.len() {
-                if self.is_active_node(a, c) && force[a][c] != 0.0 {
-                    *o += self.fluid.density * self.grid.node_volume(a, l.coords(c)) * force[a][c];
+        let rho = self.fluid.density;
+        // Active nodes are interior cells' +faces: a sum over interior cells, plane by plane in order.
+        [0, 1, 2].map(|a| {
+            crate::reduce::sum_interior(&l, |c| {
+                if force[a][c] != 0.0 && self.is_active_node(a, c) {
+                    rho * self.grid.node_volume(a, l.coords(c)) * force[a][c]
+                } else {
+                    0.0
                 }
-            }
-        }
-        out
+            })
+        })
     }
 }
 
