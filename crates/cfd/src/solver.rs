@@ -500,8 +500,12 @@ impl Flow {
         });
     }
 
-    /// Advances by `dt` seconds.
+    /// Advances by `dt` seconds (on a worker thread of the rayon pool, see [`crate::reduce::in_pool`]).
     pub fn step(&mut self, dt: f64) -> Result<StepReport, FlowError> {
+        crate::reduce::in_pool(|| self.advance(dt))
+    }
+
+    fn advance(&mut self, dt: f64) -> Result<StepReport, FlowError> {
         let l = self.grid.layout;
         let s = l.s;
         let mut h_new = std::mem::take(&mut self.h_new);

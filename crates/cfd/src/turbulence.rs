@@ -27,16 +27,21 @@
 //! directly with the momentum equation's TVD scheme; time stepping is forward Euler with the destruction
 //! terms implicit (k ← (k + Δt R)/(1 + Δt ε/k)), which keeps k and ε positive.
 //!
-//! **Wall functions** (standard log law, κ = 0.41, E = 9.793) on the no-slip sides of the box: in a cell
-//! next to a wall at distance y_p, with u* = C_μ^{1/4} k^{1/2} and y* = u* y_p/ν,
+//! **Wall functions** (standard log law, κ = 0.41, E = 9.793) on the no-slip sides of the box and on the
+//! faces of blocked cells (solids inside the grid, at rest): in a cell next to a wall at distance y_p
+//! (half the cell width across the wall face), with u* = C_μ^{1/4} k^{1/2} and y* = u* y_p/ν,
 //! * the wall shear stress is τ_w/ρ = ν_w u_t / y_p with the wall viscosity ν_w = ν y* κ / ln(E y*)
 //!   (ν below y* = 11.06), entered in the momentum equation as the viscosity of the wall face;
 //! * P_k = (τ_w/ρ) u*/(κ y_p) and ε = C_μ^{3/4} k^{3/2}/(κ y_p) (averaged over the walls of a corner cell).
 //!
 //! Inlets bring k = 1.5 (I |u_in|)² and ε = C_μ^{3/4} k^{3/2}/ℓ for a turbulence intensity I and length
-//! scale ℓ; outlets, slip sides and the axis have zero normal gradient. Blocked cells (solids inside the
-//! grid) get no wall function: their faces see the molecular viscosity only, and the model is meant for
-//! flows bounded by the box sides (pipes, channels, ducts, the axisymmetric rotor domain).
+//! scale ℓ; outlets, slip sides and the axis have zero normal gradient; no k or ε crosses a wall or the
+//! face of a blocked cell.
+//!
+//! The wall viscosity enters the momentum equation through ν_eff of the cell across the wall face: a
+//! ghost cell across a side holds 2ν_w − ν_eff(P), so that the face average is ν_w; a blocked cell holds
+//! the mean of 2ν_w − ν_eff(P) over the fluid cells P sharing a face with it, which is exact for a flat
+//! wall and an average at the edges and corners of a solid (a staircase of blocked cells).
 //! The turbulent stress is modelled as ∇·(ν_eff ∇u); the part ∇·(ν_t (∇u)ᵀ), which vanishes for
 //! developed shear flows, is left out.
 
@@ -233,9 +238,12 @@ pub struct Turbulence {
     pub model: KEpsilon,
     /// ν + ν_t per padded cell, ghosts holding the wall-function values (see [`Turbulence::fill_nu_eff`]).
     pub nu_eff: Vec<f64>,
-    /// Per fluid cell next to a no-slip side: (cell, side, distance to the wall \[m\]).
-    walls: Vec<(usize, usize, f64)>,
-    /// Whether a cell lies next to a no-slip side (its ν_t keeps the wall functions' C_μ).
+    /// The faces between fluid cells and walls (no-slip sides and blocked cells).
+    walls: Vec<WallFace>,
+    /// (blocked cell, fluid cell sharing a face with it, distance from the fluid cell's centre to the
+    /// face \[m\]), ordered by blocked cell.
+    solid_faces: Vec<(usize, usize, f64)>,
+    /// Whether a cell lies next to a wall (its ν_t keeps the wall functions' C_μ).
     at_wall: Vec<bool>,
     k_new: Vec<f64>,
     eps_new: Vec<f64>,
@@ -244,6 +252,19 @@ pub struct Turbulence {
     wall_e: Vec<f64>,
     wall_n: Vec<u8>,
     centre_ops: [DirOps; 3],
+}
+
+/// A wall face of a fluid cell.
+#[derive(Clone, Copy, Debug)]
+struct WallFace {
+    /// The fluid cell.
+    cell: usize,
+    /// Direction of the wall from the cell, as a side index (2a: −a, 2a + 1: +a).
+    side: usize,
+    /// Distance from the cell centre to the wall \[m\].
+    y: f64,
+    /// The face of a blocked cell (a wall at rest) rather than a side of the grid.
+    solid: bool,
 }
 
 fn mirror(l: &crate::grid::Layout, side: usize, c: usize) -> Option<usize> {
@@ -260,7 +281,9 @@ fn mirror(l: &crate::grid::Layout, side: usize, c: usize) -> Option<usize> {
 impl Turbulence {
     pub fn new(model: KEpsilon, grid: &Grid, bc: &[Boundary; 6], blocked: &[bool]) -> Self {
         let l = grid.layout;
+        let dims = if grid.mode == Mode::Axisymmetric { 2 } else { 3 };
         let mut walls = Vec::new();
+        let mut solid_faces = Vec::new();
         for c in 0..l.len() {
             let q = l.coords(c);
             if !l.interior(q) || blocked[c] {
@@ -269,19 +292,30 @@ impl Turbulence {
             for (side, b) in bc.iter().enumerate() {
                 if matches!(b, Boundary::Wall { .. }) && mirror(&l, side, c).is_some() {
                     let a = side / 2;
-                    walls.push((c, side, 0.5 * grid.metric[a].d[q[a]]));
+                    walls.push(WallFace { cell: c, side, y: 0.5 * grid.metric[a].d[q[a]], solid: false });
+                }
+            }
+            for a in 0..dims {
+                for (side, nb) in [(2 * a, c - l.s[a]), (2 * a + 1, c + l.s[a])] {
+                    if l.interior(l.coords(nb)) && blocked[nb] {
+                        let y = 0.5 * grid.metric[a].d[q[a]];
+                        walls.push(WallFace { cell: c, side, y, solid: true });
+                        solid_faces.push((nb, c, y));
+                    }
                 }
             }
         }
+        solid_faces.sort_by_key(|&(b, c, _)| (b, c));
         let n = l.len();
         let mut at_wall = vec![false; n];
-        for &(c, _, _) in &walls {
-            at_wall[c] = true;
+        for w in &walls {
+            at_wall[w.cell] = true;
         }
         Turbulence {
             model,
             nu_eff: vec![0.0; n],
             walls,
+            solid_faces,
             at_wall,
             k_new: vec![0.0; n],
             eps_new: vec![0.0; n],
@@ -299,7 +333,11 @@ impl Turbulence {
             + self.eps_new.capacity()
             + self.wall_p.capacity()
             + self.wall_e.capacity();
-        (8 * f + self.wall_n.capacity() + self.at_wall.capacity() + 24 * self.walls.capacity()) as u64
+        (8 * f
+            + self.wall_n.capacity()
+            + self.at_wall.capacity()
+            + std::mem::size_of::<WallFace>() * self.walls.capacity()
+            + 24 * self.solid_faces.capacity()) as u64
     }
 
     /// Initial state: the inlet values of the fastest inlet everywhere (or a small k at rest).
@@ -382,6 +420,14 @@ impl Turbulence {
                 nu
             };
         }
+        // Blocked cells next to fluid: the mean over their fluid neighbours of 2ν_w − ν_eff(P).
+        for group in self.solid_faces.chunk_by(|x, y| x.0 == y.0) {
+            let sum: f64 = group
+                .iter()
+                .map(|&(_, p, y)| 2.0 * wall_viscosity(c_mu, st.k[p], y, nu) - self.nu_eff[p])
+                .sum();
+            self.nu_eff[group[0].0] = sum / group.len() as f64;
+        }
         for (side, b) in bc.iter().enumerate() {
             let a = side / 2;
             for_side_cells(&l, side, |c, g| {
@@ -418,16 +464,16 @@ impl Turbulence {
         // Cell-centred velocity and its gradient.
         let uc = |c: usize, a: usize| 0.5 * (u[a][c] + u[a][c - s[a]]);
         // Wall functions: P_k and ε of the cells next to walls (sums over the walls, then averaged).
-        for &(c, _, _) in &self.walls {
-            self.wall_p[c] = 0.0;
-            self.wall_e[c] = 0.0;
-            self.wall_n[c] = 0;
+        for w in &self.walls {
+            self.wall_p[w.cell] = 0.0;
+            self.wall_e[w.cell] = 0.0;
+            self.wall_n[w.cell] = 0;
         }
         let cmu25 = md.c_mu.powf(0.25);
-        for &(c, side, y) in &self.walls {
+        for &WallFace { cell: c, side, y, solid } in &self.walls {
             let a = side / 2;
             let k = st.k[c].max(K_MIN);
-            let vw = bc[side].velocity(t).unwrap_or([0.0; 3]);
+            let vw = if solid { [0.0; 3] } else { bc[side].velocity(t).unwrap_or([0.0; 3]) };
             // Tangential speed relative to the wall at the cell centre.
             let mut ut2 = 0.0;
             for b in 0..dims {

@@ -261,7 +261,7 @@ pub enum TurbulenceSpec {
     /// No model: the molecular viscosity only.
     #[default]
     Laminar,
-    /// Standard k–ε with log-law wall functions on the no-slip sides (`docs/cfd.md` §2).
+    /// Standard k–ε with log-law wall functions on the no-slip sides and blocked-cell faces (`docs/cfd.md` §2).
     KEpsilon {
         /// Turbulence intensity of the inlets \[-\].
         #[serde(default = "inlet_intensity")]

@@ -40,6 +40,7 @@ use exchange::{pressure_gradient_nodes, GridFluid};
 use rayon::prelude::*;
 pub use run::{run, CfdDemError};
 use serde::{Deserialize, Serialize};
+use spatter_cfd::reduce::in_pool;
 use spatter_cfd::{Flow, FlowError, Mode};
 use spatter_core::check::{Checker, Validate};
 use spatter_core::Vec3;
@@ -196,6 +197,8 @@ pub struct Coupling {
     /// The spheres' forces of the current step \[N\] (exchanged + buoyancy).
     on_particles: Vec<Vec3>,
     inside: Vec<bool>,
+    /// The node shares of each sphere's exchanged force (`None`: outside the grid).
+    shares: Vec<Option<spatter_cfd::sources::PointForce>>,
     pub times: CouplingTimes,
     pub last: ExchangeReport,
 }
@@ -239,6 +242,7 @@ impl Coupling {
             exchanged: Vec::new(),
             on_particles: Vec::new(),
             inside: Vec::new(),
+            shares: Vec::new(),
             times: CouplingTimes::default(),
             last: ExchangeReport::default(),
         })
@@ -276,6 +280,7 @@ impl Coupling {
         self.exchanged.resize(n, Vec3::ZERO);
         self.on_particles.resize(n, Vec3::ZERO);
         self.inside.resize(n, false);
+        self.shares.resize(n, None);
         let sampler =
             GridFluid { flow: &self.flow, void_fraction: &self.void_fraction, grad_p: &self.grad_p };
         let opts = &self.options;
@@ -287,14 +292,16 @@ impl Coupling {
             .par_chunks_mut(CHUNK)
             .zip(self.on_particles.par_chunks_mut(CHUNK))
             .zip(self.inside.par_chunks_mut(CHUNK))
+            .zip(self.shares.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(ch, ((ex, on), ins))| {
+            .for_each(|(ch, (((ex, on), ins), sh))| {
                 for k in 0..ex.len() {
                     let i = ch * CHUNK + k;
                     let Some(f) = sampler.fluid_at(p.pos[i], t, &mut 0) else {
                         ex[k] = Vec3::ZERO;
                         on[k] = Vec3::ZERO;
                         ins[k] = false;
+                        sh[k] = None;
                         continue;
                     };
                     let r = p.radius[i];
@@ -311,10 +318,11 @@ impl Coupling {
                     ex[k] = e;
                     on[k] = e + buoyancy;
                     ins[k] = true;
+                    sh[k] = sampler.flow.point_force_shares(p.pos[i].to_array(), (-e).to_array());
                 }
             });
-        // Spread onto the fluid in particle order (a sequential scatter: the same sums on any thread
-        // count).
+        // Spread onto the fluid in particle order (the shares are computed in parallel above, the
+        // scatter is sequential: the same sums on any thread count).
         if let Some(force) = self.flow.force.as_mut() {
             force.iter_mut().for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
         }
@@ -325,11 +333,12 @@ impl Coupling {
                 outside += 1;
                 continue;
             }
-            let e = self.exchanged[i];
-            if self.flow.add_point_force(p.pos[i].to_array(), (-e).to_array()) {
-                from += e;
-            } else {
-                outside += 1;
+            match &self.shares[i] {
+                Some(sh) => {
+                    self.flow.apply_point_force(sh);
+                    from += self.exchanged[i];
+                }
+                None => outside += 1,
             }
         }
         let (ext, _) = dem.particles.external_force_mut();
@@ -349,6 +358,16 @@ impl Coupling {
     /// fluid step of Δt_f = `substeps` × the DEM step (the caller then advances the DEM by as many
     /// steps).
     pub fn exchange_and_advance<L: ContactLaw>(
+        &mut self,
+        dem: &mut Simulation<L>,
+        substeps: u32,
+    ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
+        // On a worker thread of the pool: its many short parallel loops then start without a round trip
+        // through the scheduler each (spatter_cfd::reduce::in_pool).
+        in_pool(|| self.exchange_and_advance_here(dem, substeps))
+    }
+
+    fn exchange_and_advance_here<L: ContactLaw>(
         &mut self,
         dem: &mut Simulation<L>,
         substeps: u32,
@@ -394,11 +413,13 @@ impl<L: ContactLaw> Coupled<L> {
     pub fn step_reporting(
         &mut self,
     ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
-        let n = self.coupling.options.dem_steps_per_fluid_step;
-        let out = self.coupling.exchange_and_advance(&mut self.dem, n)?;
-        let t1 = Instant::now();
-        self.dem.run_steps(self.coupling.options.dem_steps_per_fluid_step as u64)?;
-        self.coupling.times.dem += t1.elapsed().as_secs_f64();
-        Ok(out)
+        in_pool(|| {
+            let n = self.coupling.options.dem_steps_per_fluid_step;
+            let out = self.coupling.exchange_and_advance(&mut self.dem, n)?;
+            let t1 = Instant::now();
+            self.dem.run_steps(self.coupling.options.dem_steps_per_fluid_step as u64)?;
+            self.coupling.times.dem += t1.elapsed().as_secs_f64();
+            Ok(out)
+        })
     }
 }

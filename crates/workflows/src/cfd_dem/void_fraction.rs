@@ -34,25 +34,25 @@ pub enum VoidFractionMethod {
 /// Lattice points per axis of the divided method.
 const LATTICE: usize = 6;
 
-/// Offsets (in units of the radius) of the divided method's points inside the unit sphere.
-fn divided_points() -> Vec<Vec3> {
-    let h = 2.0 / LATTICE as f64;
+/// The divided method's points inside the unit sphere: lattice indices (i, j, k) along x, y, z, in the
+/// order their shares are booked. A point sits at (−1 + (i + ½)·2/6, …) radii from the centre.
+fn divided_points() -> Vec<[u8; 3]> {
     let mut out = Vec::new();
     for k in 0..LATTICE {
         for j in 0..LATTICE {
             for i in 0..LATTICE {
-                let p = Vec3::new(
-                    -1.0 + h * (i as f64 + 0.5),
-                    -1.0 + h * (j as f64 + 0.5),
-                    -1.0 + h * (k as f64 + 0.5),
-                );
-                if p.length_squared() <= 1.0 {
-                    out.push(p);
+                if lattice_offset(i).powi(2) + lattice_offset(j).powi(2) + lattice_offset(k).powi(2) <= 1.0 {
+                    out.push([i as u8, j as u8, k as u8]);
                 }
             }
         }
     }
     out
+}
+
+/// Offset of lattice coordinate `i` from the centre, in radii.
+fn lattice_offset(i: usize) -> f64 {
+    -1.0 + 2.0 / LATTICE as f64 * (i as f64 + 0.5)
 }
 
 /// The void-fraction field and its workspace.
@@ -65,7 +65,7 @@ pub struct VoidFraction {
     pub alpha: Vec<f64>,
     /// Solid volume booked per padded cell in the last update \[m³\].
     pub solid: Vec<f64>,
-    points: Vec<Vec3>,
+    points: Vec<[u8; 3]>,
 }
 
 impl VoidFraction {
@@ -103,11 +103,25 @@ impl VoidFraction {
                     None => outside += v,
                 },
                 VoidFractionMethod::Divided => {
+                    // The points share their coordinates along each axis with a lattice plane, so the
+                    // cell index along an axis is located once per plane (6 per axis instead of once per
+                    // point); the shares are booked in the same point order as before.
                     let dv = v * share;
-                    for &p in &self.points {
-                        match Self::cell_of(grid, x + r * p) {
-                            Some(c) => self.solid[c] += dv,
-                            None => outside += dv,
+                    let xa = x.to_array();
+                    let mut offset = [[None::<usize>; LATTICE]; 3];
+                    for (a, row) in offset.iter_mut().enumerate() {
+                        let ax = &grid.axes[a];
+                        for (i, o) in row.iter_mut().enumerate() {
+                            let y = xa[a] + r * lattice_offset(i);
+                            if y >= ax.lo() && y <= ax.hi() {
+                                *o = Some(grid.layout.s[a] * (ax.locate(y) + GHOST));
+                            }
+                        }
+                    }
+                    for &[i, j, k] in &self.points {
+                        match (offset[0][i as usize], offset[1][j as usize], offset[2][k as usize]) {
+                            (Some(a), Some(b), Some(c)) => self.solid[a + b + c] += dv,
+                            _ => outside += dv,
                         }
                     }
                 }

@@ -168,9 +168,8 @@ pub struct AirFieldKeys {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CoupledTurbulence {
-    /// Standard k–ε with log-law wall functions (the published study's model): refused for now, the
-    /// flow solver's wall functions act on the sides of the grid only, not on the faces of blocked cells
-    /// that make the pipe (see `docs/gravelometer.md`).
+    /// Standard k–ε with log-law wall functions on the faces of the blocked cells that make the pipe and
+    /// the box (the published study's model).
     KEpsilon,
     /// No model: the molecular viscosity only (the default).
     #[default]
@@ -646,15 +645,6 @@ impl Validate for GravelometerConfig {
                 }
             }
             c.in_range("inlet_intensity", a.inlet_intensity.unwrap_or(f64::NAN), 0.0, false, 1.0, true);
-            if a.turbulence == Some(CoupledTurbulence::KEpsilon) {
-                c.fail(
-                    "turbulence",
-                    "turbulence = \"k_epsilon\" is not available for the gravelometer yet: the flow solver's \
-                     wall functions act on the sides of the grid only, and the pipe here is made of blocked \
-                     cells, where k–ε without them runs away (k grows without bound near the pipe wall); use \
-                     turbulence = \"laminar\"",
-                );
-            }
             if a.dem_steps_per_fluid_step == Some(0) {
                 c.fail("dem_steps_per_fluid_step", "= 0: give at least 1 DEM step per fluid step");
             }

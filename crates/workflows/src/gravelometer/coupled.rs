@@ -11,8 +11,8 @@
 //!   bore at x = −L with the bulk speed `pipe.air_velocity_m_s` ramped linearly over
 //!   `air_field.ramp_s` (the valve opening), a pressure outlet p = 0 on the box's far wall (x = max; the
 //!   study's box outlet is not located in its text, so its place is assumed), no-slip walls elsewhere.
-//! * **Turbulence**: laminar. The study's standard k–ε is refused for now: the flow solver's wall
-//!   functions act on the sides of the grid only, and this pipe is made of blocked cells.
+//! * **Turbulence**: laminar (default) or the study's standard k–ε, whose log-law wall functions act on
+//!   the faces of the blocked cells that make the pipe.
 //! * **Coupling**: model A, the divided void fraction, the drag law of `air_field.drag` on every member
 //!   sphere (`docs/cfd.md`), Archimedes buoyancy; one fluid step every `dem_steps_per_fluid_step` DEM
 //!   steps (default: a fluid Courant number of about 0.4 at 1.3 × the bulk speed).
