@@ -117,13 +117,7 @@ impl Simulation {
             clock = now;
             d
         };
-        self.predict(dt);
-        self.work.times.predict += lap();
-        self.work.frames_old.clear();
-        self.work.frames_old.extend_from_slice(&self.boundary.frames);
-        self.count_flux();
-        self.boundary.update_kinematics(&self.tree, t1);
-        let guard_hits = self.guard();
+        let guard_hits = self.predict_and_move_walls(dt, t1, &mut lap);
         let bad = self.drop_non_finite();
         let before = self.removed;
         // Cannot fail: the only error of the wrap is a non-finite particle, dropped above.

@@ -908,14 +908,7 @@ impl Simulation {
                 d
             }
         };
-        self.predict(dt);
-        self.work.times.predict += lap();
-        // Walls move to the new time; the guard stops crossings.
-        self.work.frames_old.clear();
-        self.work.frames_old.extend_from_slice(&self.boundary.frames);
-        self.count_flux();
-        self.boundary.update_kinematics(&self.tree, t1);
-        self.last.guard_hits = self.guard();
+        self.last.guard_hits = self.predict_and_move_walls(dt, t1, &mut lap);
         self.wrap_and_remove()?;
         self.work.times.walls_guard += lap();
         // Forces at the new positions.
@@ -933,6 +926,19 @@ impl Simulation {
     }
 
     /// Predictor and drift: `x ← x + dt (v + ½dt a) + shift`, `v* = v + dt a`, `ρ* = ρ + dt Dρ`.
+    /// The start of a step shared by [`Self::step`] and the step over ranks: predictor, then the walls
+    /// move to the new time `t1` \[s\] (the old frames kept for the guard), plane fluxes are counted and
+    /// the guard stops crossings. Returns the number of guard hits.
+    pub(crate) fn predict_and_move_walls(&mut self, dt: f64, t1: f64, lap: &mut dyn FnMut() -> f64) -> u64 {
+        self.predict(dt);
+        self.work.times.predict += lap();
+        self.work.frames_old.clear();
+        self.work.frames_old.extend_from_slice(&self.boundary.frames);
+        self.count_flux();
+        self.boundary.update_kinematics(&self.tree, t1);
+        self.guard()
+    }
+
     fn predict(&mut self, dt: f64) {
         {
             let f = &mut self.fluid;
