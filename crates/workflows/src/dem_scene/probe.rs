@@ -127,7 +127,7 @@ pub(crate) fn check(c: &mut Checker, cfg: &SceneConfig, p: &ProbeConfig) {
             }
             ProbeShape::Mesh { file, scale } => {
                 c.positive("scale", *scale);
-                c.file_exists("file", file);
+                c.mesh_file("file", file);
             }
         });
         if p.speed_m_s > 0.0 && p.max_depth_m > 0.0 && cfg.duration_s < p.max_depth_m / p.speed_m_s {
