@@ -149,7 +149,8 @@ fn two_ranks_match_one_rank() {
          print(r.GetOutput().GetNumberOfPoints())",
         b.join("particles/particles_00001.pvtu").to_str().unwrap()
     );
-    match Command::new("python3").args(["-c", &script]).output() {
+    // The system Python, where `.ci/run` installs python3-vtk9; a `python3` earlier on PATH may lack VTK.
+    match Command::new("/usr/bin/python3").args(["-c", &script]).output() {
         Ok(o) if o.status.success() => assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "16000"),
         other => assert!(std::env::var("SPATTER_REQUIRE_VTK").is_err(), "VTK is required here: {other:?}"),
     }
