@@ -18,6 +18,7 @@ Examples:
   spatter run study.toml --out runs/a --threads 2
   spatter run study.toml --out runs/a --resume   # continue after Ctrl-C, SIGTERM or a kill
   spatter run study.toml --out runs/a --overwrite # replace an earlier run's files
+  mpirun -n 4 spatter run dam.toml --out runs/d --resume --repartition # continue on another rank count
   spatter check study.toml                       # validate and print the resolved input
   spatter validate --quick                       # reference cases, table of errors, non-zero exit on failure
   spatter bench dem                              # throughput of an engine
@@ -54,6 +55,10 @@ enum Command {
         /// Delete the files of an earlier run in the output folder before starting.
         #[arg(long)]
         overwrite: bool,
+        /// With --resume: continue a checkpoint written on another number of MPI ranks, splitting it
+        /// afresh over the ranks of this run (results then differ from an uninterrupted run at round-off).
+        #[arg(long)]
+        repartition: bool,
         /// Wall-clock seconds between periodic checkpoints (a kill loses at most this much work).
         #[arg(long, default_value_t = spatter_scenario::job::DEFAULT_CHECKPOINT_INTERVAL_S)]
         checkpoint_interval_s: f64,
@@ -223,6 +228,7 @@ fn main() -> ExitCode {
             threads,
             resume,
             overwrite,
+            repartition,
             checkpoint_interval_s,
             verbose,
             quiet,
@@ -233,6 +239,7 @@ fn main() -> ExitCode {
                 threads,
                 resume,
                 overwrite,
+                repartition,
                 checkpoint_interval_s,
                 verbose,
                 quiet,

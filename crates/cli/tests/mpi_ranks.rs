@@ -2,7 +2,8 @@
 //! `cargo test -p spatter-cli --features mpi --test mpi_ranks` (CI runs it; needs libopenmpi-dev).
 //! One rank under mpirun is the ordinary run, file for file; the `sph` dam break on two ranks agrees with
 //! it within the stated tolerance; kinds that do not run on several ranks are refused by every rank with
-//! one sentence on rank 0, before anything is written, and never hang.
+//! one sentence on rank 0, before anything is written, and never hang. A two-rank run stopped part-way
+//! resumes on two ranks bit for bit, and on one rank with `--repartition` (refused without it).
 #![cfg(feature = "mpi")]
 
 mod common;
@@ -19,9 +20,18 @@ fn example(name: &str) -> PathBuf {
 }
 
 fn mpirun(ranks: usize, args: &[&str]) -> Output {
-    let out = Command::new("timeout")
-        .arg(KILL_AFTER_S.to_string())
-        .args(["mpirun", "--oversubscribe", "-n", &ranks.to_string(), env!("CARGO_BIN_EXE_spatter")])
+    mpirun_env(ranks, args, &[])
+}
+
+/// [`mpirun`] with environment variables `envs` set on every rank (`-x`).
+fn mpirun_env(ranks: usize, args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = Command::new("timeout");
+    c.arg(KILL_AFTER_S.to_string()).args(["mpirun", "--oversubscribe", "-n", &ranks.to_string()]);
+    for (k, v) in envs {
+        c.args(["-x", k]).env(k, v);
+    }
+    let out = c
+        .arg(env!("CARGO_BIN_EXE_spatter"))
         .args(args)
         // Containers and CI often run as root; OpenMPI refuses that unless told.
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
@@ -85,25 +95,9 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (head, rows)
 }
 
-/// The 3D dam break (`--smoke`) on two ranks against a plain run: every `series.csv` column within 10⁻⁶
-/// of its scale (the largest magnitude of the column, or of the force or moment vector it belongs to):
-/// pairs across the rank cut are evaluated in double precision, the others in single precision, so the
-/// runs differ at that rounding (measured: 1.1·10⁻⁹ for the kinetic energy, 7·10⁻⁹ for the tank load);
-/// counts exact. Each output is a `.pvtu` of one piece per rank, holding every particle once.
-#[test]
-fn two_ranks_match_one_rank() {
-    let tmp = tempfile::tempdir().unwrap();
-    let scenario = example("sph_dam_break.toml");
-    let scenario = scenario.to_str().unwrap();
-    let (a, b) = (tmp.path().join("plain"), tmp.path().join("mpirun2"));
-    let args = |out: &Path| {
-        ["run", scenario, "--smoke", "--threads", "1", "--out", out.to_str().unwrap()].map(String::from)
-    };
-    let (ra, rb) = (args(&a), args(&b));
-    let pa = plain(&ra.each_ref().map(String::as_str));
-    assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
-    let pb = mpirun(2, &rb.each_ref().map(String::as_str));
-    assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
+/// Every `series.csv` column of run folder `b` within 10⁻⁶ of its scale of `a` (the largest magnitude of
+/// the column in `a`, or of the force or moment vector it belongs to); particle and step counts exact.
+fn assert_series_close(a: &Path, b: &Path, what: &str) {
     let (cols, rows1) = read_csv(&a.join("series.csv"));
     let (cols2, rows2) = read_csv(&b.join("series.csv"));
     assert_eq!(cols, cols2);
@@ -134,14 +128,36 @@ fn two_ranks_match_one_rank() {
             .fold(0.0, f64::max);
         for (r1, r2) in rows1.iter().zip(&rows2) {
             let (x, y) = (r1[k], r2[k]);
-            assert_eq!(x.is_nan(), y.is_nan(), "column {name}: {x} vs {y}");
+            assert_eq!(x.is_nan(), y.is_nan(), "{what}, column {name}: {x} vs {y}");
             if name == "particles" || name == "step" {
-                assert_eq!(x, y, "column {name}");
+                assert_eq!(x, y, "{what}, column {name}");
             } else if x.is_finite() {
-                assert!((x - y).abs() <= 1e-6 * scale, "column {name}: {y} vs {x} (scale {scale})");
+                assert!((x - y).abs() <= 1e-6 * scale, "{what}, column {name}: {y} vs {x} (scale {scale})");
             }
         }
     }
+}
+
+/// The 3D dam break (`--smoke`) on two ranks against a plain run: every `series.csv` column within 10⁻⁶
+/// of its scale (the largest magnitude of the column, or of the force or moment vector it belongs to):
+/// pairs across the rank cut are evaluated in double precision, the others in single precision, so the
+/// runs differ at that rounding (measured: 1.1·10⁻⁹ for the kinetic energy, 7·10⁻⁹ for the tank load);
+/// counts exact. Each output is a `.pvtu` of one piece per rank, holding every particle once.
+#[test]
+fn two_ranks_match_one_rank() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = example("sph_dam_break.toml");
+    let scenario = scenario.to_str().unwrap();
+    let (a, b) = (tmp.path().join("plain"), tmp.path().join("mpirun2"));
+    let args = |out: &Path| {
+        ["run", scenario, "--smoke", "--threads", "1", "--out", out.to_str().unwrap()].map(String::from)
+    };
+    let (ra, rb) = (args(&a), args(&b));
+    let pa = plain(&ra.each_ref().map(String::as_str));
+    assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
+    let pb = mpirun(2, &rb.each_ref().map(String::as_str));
+    assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
+    assert_series_close(&a, &b, "two ranks against one");
     let pvtu = std::fs::read_to_string(b.join("particles/particles_00001.pvtu")).unwrap();
     assert!(pvtu.contains("particles_00001_r0000.vtu") && pvtu.contains("particles_00001_r0001.vtu"));
     let script = format!(
@@ -154,4 +170,68 @@ fn two_ranks_match_one_rank() {
         Ok(o) if o.status.success() => assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "16000"),
         other => assert!(std::env::var("SPATTER_REQUIRE_VTK").is_err(), "VTK is required here: {other:?}"),
     }
+}
+
+/// The command line of a `--smoke` dam break into `out` with `extra` arguments.
+fn dam_break(out: &Path, extra: &[&str]) -> Vec<String> {
+    let scenario = example("sph_dam_break.toml");
+    let mut a: Vec<String> =
+        ["run", scenario.to_str().unwrap(), "--smoke", "--threads", "1", "--out"].map(String::from).to_vec();
+    a.push(out.to_str().unwrap().into());
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
+fn strs(a: &[String]) -> Vec<&str> {
+    a.iter().map(String::as_str).collect()
+}
+
+/// Two ranks stopped after 40 polls (a checkpoint written at every poll, by both ranks) and resumed on
+/// two ranks: every file byte for byte as the uninterrupted two-rank run. The same checkpoint on one rank
+/// is refused without `--repartition` (exit 2, one sentence, nothing changed) and continues with it,
+/// within 10⁻⁶ of each `series.csv` column's scale of the uninterrupted two-rank run (the pairs across the
+/// rank cut are summed in another precision and order once the fluid is on one rank; see
+/// `two_ranks_match_one_rank`), the particle count exact.
+#[test]
+fn two_ranks_resume_on_two_and_on_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (whole, split, one) = (tmp.path().join("whole"), tmp.path().join("split"), tmp.path().join("one"));
+    let o = mpirun(2, &strs(&dam_break(&whole, &[])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The second run logs debug messages: rank 1's go to its own log, which rank 0's log names.
+    for (dir, log) in [(&split, "info"), (&one, "debug")] {
+        let envs = [("SPATTER_STOP_AFTER_POLLS", "40"), ("RUST_LOG", log)];
+        let o = mpirun_env(2, &strs(&dam_break(dir, &["--checkpoint-interval-s", "1e-9"])), &envs);
+        assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(dir.join("checkpoint.bin").is_file());
+        assert!(dir.join("checkpoint").read_dir().unwrap().count() == 2, "one part per rank");
+    }
+    assert!(!split.join("ranks").exists(), "rank 1 had nothing to say at level info");
+    let rank1 = std::fs::read_to_string(one.join("ranks/log_r0001.txt")).unwrap();
+    assert!(rank1.contains("checkpoint part 1 written"), "{rank1}");
+    let log0 = std::fs::read_to_string(one.join("log.txt")).unwrap();
+    assert!(log0.contains("see ranks/log_r0001.txt") && !log0.contains("checkpoint part 1"), "{log0}");
+    let o = mpirun(2, &strs(&dam_break(&split, &["--resume"])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!split.join("checkpoint.bin").exists() && !split.join("checkpoint").exists());
+    assert_same_files(&whole, &split, "two ranks against two ranks stopped and resumed on two");
+    // Another rank count: refused on rank 0 with one sentence, before anything changes.
+    let before = common::run_files(&one);
+    let o = mpirun(1, &strs(&dam_break(&one, &["--resume"])));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(
+        err.matches("written by 2 ranks and this run has 1 rank: add --repartition").count(),
+        1,
+        "{err}"
+    );
+    assert!(before == common::run_files(&one), "a refused resume changes nothing");
+    let o = mpirun(1, &strs(&dam_break(&one, &["--resume", "--repartition"])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_series_close(&whole, &one, "two ranks against two resumed on one");
+    // `--repartition` needs `--resume`.
+    let o = mpirun(2, &strs(&dam_break(&tmp.path().join("fresh"), &["--repartition"])));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.matches("it needs --resume").count(), 1, "{err}");
 }

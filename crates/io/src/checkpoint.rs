@@ -16,6 +16,10 @@
 //! [`load`] refuses, each with a sentence naming the file: a file that is not a checkpoint, another format
 //! version, a truncated or extended file, a body whose checksum does not match (a flipped byte), and a
 //! checkpoint stamped with another input. Decoding happens only after all of these pass.
+//!
+//! A run split over several ranks writes one such file per rank and a *manifest* listing them, in the same
+//! layout with the magic `SPTRMANI` (see [`crate::rank_checkpoint`]); [`verify`] accepts both, [`load`]
+//! refuses a manifest with a sentence naming its rank count.
 
 use serde::{de::DeserializeOwned, Serialize};
 use std::io::Write;
@@ -23,6 +27,8 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 const MAGIC: &[u8; 8] = b"SPTRCKPT";
+/// Magic of the manifest of a checkpoint written on several ranks.
+const MANIFEST_MAGIC: &[u8; 8] = b"SPTRMANI";
 /// Format version written by this build. Version 1 had no input hash, length or checksum.
 pub const VERSION: u32 = 2;
 const HEADER: usize = 36;
@@ -47,6 +53,42 @@ pub enum CheckpointError {
     OtherInput { path: PathBuf, found: u64, expected: u64 },
     #[error("checkpoint {path} cannot be decoded (written by another build?): {message}")]
     Decode { path: PathBuf, message: String },
+    /// The checkpoint was written on another number of ranks than this run has.
+    #[error(
+        "checkpoint {path} was written by {} and this run has {}: add --repartition to continue on {} \
+         (the results then differ from an uninterrupted {written}-rank run at round-off level), or {}",
+        ranks_text(*written), ranks_text(*ranks), ranks_text(*ranks), same_ranks_hint(*written)
+    )]
+    RankCount { path: PathBuf, written: usize, ranks: usize },
+    /// Another rank failed to read or write its part of a checkpoint (the rank's own error is on its
+    /// standard error stream).
+    #[error("rank {rank}: {message}")]
+    OnRank { rank: usize, message: String },
+}
+
+fn ranks_text(n: usize) -> String {
+    if n == 1 {
+        "1 rank".into()
+    } else {
+        format!("{n} ranks")
+    }
+}
+
+fn same_ranks_hint(written: usize) -> String {
+    if written == 1 {
+        "resume it without mpirun".into()
+    } else {
+        format!("resume it on {written} ranks (mpirun -n {written})")
+    }
+}
+
+/// What a checkpoint file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A whole job's state ([`save`]).
+    State,
+    /// The manifest of a checkpoint written on several ranks ([`crate::rank_checkpoint`]).
+    Manifest,
 }
 
 /// 64-bit FNV-1a hash of `bytes`.
@@ -65,22 +107,40 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
 
 /// Writes `value` to `path` atomically, stamped with `input_hash` (see the module docs).
 pub fn save<T: Serialize>(path: &Path, input_hash: u64, value: &T) -> Result<(), CheckpointError> {
+    let body = encode(path, value)?;
+    write_atomic(path, Kind::State, input_hash, &body)
+}
+
+/// The body [`save`] writes for `value` (bincode); `path` names the file in the error.
+pub(crate) fn encode<T: Serialize>(path: &Path, value: &T) -> Result<Vec<u8>, CheckpointError> {
+    bincode::serialize(value)
+        .map_err(|e| CheckpointError::Decode { path: path.to_owned(), message: e.to_string() })
+}
+
+/// Writes header and `body` to `path` atomically (temporary file, flushed, renamed, folder synced).
+pub(crate) fn write_atomic(
+    path: &Path,
+    kind: Kind,
+    input_hash: u64,
+    body: &[u8],
+) -> Result<(), CheckpointError> {
     let io = |source| CheckpointError::Io { path: path.to_owned(), source };
-    let body = bincode::serialize(value)
-        .map_err(|e| CheckpointError::Decode { path: path.to_owned(), message: e.to_string() })?;
     let mut tmp_name = path.as_os_str().to_owned();
     tmp_name.push(".tmp");
     let tmp = PathBuf::from(tmp_name);
     {
         let mut f = std::fs::File::create(&tmp).map_err(io)?;
         let mut head = Vec::with_capacity(HEADER);
-        head.extend_from_slice(MAGIC);
+        head.extend_from_slice(match kind {
+            Kind::State => MAGIC,
+            Kind::Manifest => MANIFEST_MAGIC,
+        });
         head.extend_from_slice(&VERSION.to_le_bytes());
         head.extend_from_slice(&input_hash.to_le_bytes());
         head.extend_from_slice(&(body.len() as u64).to_le_bytes());
-        head.extend_from_slice(&fnv1a(&body).to_le_bytes());
+        head.extend_from_slice(&fnv1a(body).to_le_bytes());
         f.write_all(&head).map_err(io)?;
-        f.write_all(&body).map_err(io)?;
+        f.write_all(body).map_err(io)?;
         f.sync_all().map_err(io)?;
     }
     std::fs::rename(&tmp, path).map_err(io)?;
@@ -108,11 +168,16 @@ fn u64_at(b: &[u8], at: usize) -> u64 {
     u64::from_le_bytes(a)
 }
 
-/// Checks the file's bytes and returns the verified body.
-fn verified<'a>(path: &Path, bytes: &'a [u8], input_hash: u64) -> Result<&'a [u8], CheckpointError> {
+/// Checks the file's bytes and returns what it holds and the verified body.
+fn verified<'a>(path: &Path, bytes: &'a [u8], input_hash: u64) -> Result<(Kind, &'a [u8]), CheckpointError> {
     let damaged = |what: String| CheckpointError::Damaged { path: path.to_owned(), what };
-    if bytes.len() < 12 || &bytes[..8] != MAGIC {
-        if bytes.len() < 8 && MAGIC.starts_with(bytes) {
+    let kind = match bytes.get(..8) {
+        Some(m) if m == MAGIC => Kind::State,
+        Some(m) if m == MANIFEST_MAGIC => Kind::Manifest,
+        _ => Kind::State,
+    };
+    if bytes.len() < 12 || (&bytes[..8] != MAGIC && &bytes[..8] != MANIFEST_MAGIC) {
+        if bytes.len() < 8 && (MAGIC.starts_with(bytes) || MANIFEST_MAGIC.starts_with(bytes)) {
             return Err(damaged(format!("only {} bytes, cut off inside the header", bytes.len())));
         }
         return Err(CheckpointError::NotACheckpoint { path: path.to_owned() });
@@ -149,24 +214,52 @@ fn verified<'a>(path: &Path, bytes: &'a [u8], input_hash: u64) -> Result<&'a [u8
             expected: input_hash,
         });
     }
-    Ok(body)
+    Ok((kind, body))
 }
 
-/// Reads a checkpoint written by [`save`], refusing it (see the module docs) unless it is intact and, when
-/// `input_hash` is not 0, stamped with that hash.
-pub fn load<T: DeserializeOwned>(path: &Path, input_hash: u64) -> Result<T, CheckpointError> {
+/// Reads the file at `path` and returns what it holds and its verified body (see [`load`]).
+pub(crate) fn read_verified(path: &Path, input_hash: u64) -> Result<(Kind, Vec<u8>), CheckpointError> {
     let bytes =
         std::fs::read(path).map_err(|source| CheckpointError::Io { path: path.to_owned(), source })?;
-    let body = verified(path, &bytes, input_hash)?;
+    let (kind, body) = verified(path, &bytes, input_hash)?;
+    let at = bytes.len() - body.len();
+    let mut bytes = bytes;
+    bytes.drain(..at);
+    Ok((kind, bytes))
+}
+
+/// Decodes a verified body.
+pub(crate) fn decode<T: DeserializeOwned>(path: &Path, body: &[u8]) -> Result<T, CheckpointError> {
     bincode::deserialize(body)
         .map_err(|e| CheckpointError::Decode { path: path.to_owned(), message: e.to_string() })
 }
 
+/// Reads a checkpoint written by [`save`], refusing it (see the module docs) unless it is intact and, when
+/// `input_hash` is not 0, stamped with that hash.
+/// A manifest (a checkpoint written on several ranks) is refused with [`CheckpointError::RankCount`].
+pub fn load<T: DeserializeOwned>(path: &Path, input_hash: u64) -> Result<T, CheckpointError> {
+    let (kind, body) = read_verified(path, input_hash)?;
+    if kind == Kind::Manifest {
+        let written = crate::rank_checkpoint::Manifest::decode(path, &body)?.ranks();
+        return Err(CheckpointError::RankCount { path: path.to_owned(), written, ranks: 1 });
+    }
+    decode(path, &body)
+}
+
 /// Checks that the checkpoint at `path` is intact and belongs to `input_hash` without decoding it.
+/// A manifest is checked as a file (the parts it lists are checked when they are read).
 pub fn verify(path: &Path, input_hash: u64) -> Result<(), CheckpointError> {
-    let bytes =
-        std::fs::read(path).map_err(|source| CheckpointError::Io { path: path.to_owned(), source })?;
-    verified(path, &bytes, input_hash).map(|_| ())
+    written_by(path, input_hash).map(|_| ())
+}
+
+/// Checks the checkpoint at `path` like [`verify`] and returns the number of ranks that wrote it (1 for
+/// the checkpoint of a one-rank run).
+pub fn written_by(path: &Path, input_hash: u64) -> Result<usize, CheckpointError> {
+    let (kind, body) = read_verified(path, input_hash)?;
+    match kind {
+        Kind::State => Ok(1),
+        Kind::Manifest => Ok(crate::rank_checkpoint::Manifest::decode(path, &body)?.ranks()),
+    }
 }
 
 #[cfg(test)]

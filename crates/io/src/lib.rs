@@ -8,6 +8,7 @@
 //!   OpenFOAM's `foamToVTK`) into one unstructured dataset, and `.pvd`/`.series` time series;
 //! * [`pvd`] — ParaView `.pvd` collections that tie VTU snapshots to times;
 //! * [`checkpoint`] — atomic, versioned, checksummed binary snapshots of a job's state;
+//! * [`rank_checkpoint`] — the same for a run split over ranks: one part per rank and a manifest;
 //! * [`runlog`] — the current run's `log.txt`, where the program's one `tracing` subscriber writes;
 //! * [`plot`] — PNG/SVG charts and mesh colour maps;
 //! * [`summary`] — `summary.json`, a run's result in machine-readable form;
@@ -18,6 +19,7 @@ pub mod csv;
 pub mod paths;
 pub mod plot;
 pub mod pvd;
+pub mod rank_checkpoint;
 pub mod report;
 pub mod run;
 pub mod runlog;

@@ -66,12 +66,15 @@ pub struct RunContext<'a> {
     pub input_hash: u64,
     /// The ranks this run is split over (one, [`SERIAL`], unless started by `mpirun`).
     pub comm: &'a dyn Comm,
+    /// With [`RunContext::resume`]: the checkpoint may come from another number of ranks than `comm`
+    /// has (`--repartition`); the job then splits the state afresh.
+    pub repartition: bool,
 }
 
 impl<'a> RunContext<'a> {
     /// A one-rank context without an input hash (checkpoints are not stamped, any checkpoint is accepted).
     pub fn new(dir: &'a RunDir, control: &'a dyn RunControl, resume: bool) -> Self {
-        RunContext { dir, control, resume, input_hash: 0, comm: &SERIAL }
+        RunContext { dir, control, resume, input_hash: 0, comm: &SERIAL, repartition: false }
     }
 
     /// Writes `state` to `dir/checkpoint.bin` atomically, stamped with [`RunContext::input_hash`].
@@ -86,10 +89,51 @@ impl<'a> RunContext<'a> {
         crate::checkpoint::load(&self.dir.checkpoint_path(), self.input_hash)
     }
 
+    /// On several ranks: every rank writes its `part` and rank 0 the manifest `dir/checkpoint.bin`
+    /// ([`crate::rank_checkpoint::save_parts`]; collective). A one-rank job writes its whole state with
+    /// [`RunContext::save_checkpoint`] instead.
+    pub fn save_checkpoint_part<P: Serialize>(&self, part: &P) -> Result<(), CheckpointError> {
+        crate::rank_checkpoint::save_parts(self.dir.root(), self.input_hash, part, self.comm)?;
+        tracing::debug!("checkpoint part {} written", self.comm.rank());
+        Ok(())
+    }
+
+    /// Reads the checkpoint of a job that runs on ranks: a one-rank state `S` or per-rank parts `P`
+    /// ([`crate::rank_checkpoint::load_parts`] with [`RunContext::repartition`]; collective).
+    pub fn load_checkpoint_parts<S: DeserializeOwned, P: DeserializeOwned>(
+        &self,
+    ) -> Result<crate::rank_checkpoint::Resumed<S, P>, CheckpointError> {
+        crate::rank_checkpoint::load_parts(self.dir.root(), self.input_hash, self.comm, self.repartition)
+    }
+
     /// True when the job should write a checkpoint now and carry on (periodic checkpoints).
     pub fn checkpoint_due(&self) -> bool {
         self.control.checkpoint_due()
     }
+
+    /// Whether to stop, and whether to write a checkpoint, now. Collective on several ranks: a stop
+    /// request (a signal reaches the ranks at different moments) on any rank stops every rank after the
+    /// same step, and rank 0's timer decides the periodic checkpoints. On one rank: the control's stop
+    /// request, else its checkpoint timer (not asked when stopping).
+    pub fn poll(&self) -> Poll {
+        let stop = self.control.stop_requested();
+        if self.comm.size() == 1 {
+            return Poll { stop, checkpoint: !stop && self.checkpoint_due() };
+        }
+        let due = self.comm.is_root() && self.checkpoint_due();
+        let mut v = [f64::from(u8::from(stop)), f64::from(u8::from(due))];
+        self.comm.all_max_f64(&mut v);
+        Poll { stop: v[0] > 0.0, checkpoint: v[1] > 0.0 }
+    }
+}
+
+/// What [`RunContext::poll`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Poll {
+    /// Stop now (after writing a checkpoint).
+    pub stop: bool,
+    /// Write a periodic checkpoint and carry on.
+    pub checkpoint: bool,
 }
 
 /// What a job tells the user when it returns.

@@ -46,6 +46,9 @@ pub struct JobOptions {
     /// Files in `out` that belong to the caller (a study's `case.toml`): not another run's files, and
     /// kept by `overwrite`.
     pub keep: Vec<String>,
+    /// With `resume`: continue a checkpoint written on another number of ranks than this run has,
+    /// splitting the state afresh (`--repartition`; kinds that run on several ranks only).
+    pub repartition: bool,
 }
 
 impl JobOptions {
@@ -57,6 +60,7 @@ impl JobOptions {
             overwrite: false,
             checkpoint_interval_s: DEFAULT_CHECKPOINT_INTERVAL_S,
             keep: Vec::new(),
+            repartition: false,
         }
     }
 }
@@ -96,35 +100,36 @@ pub fn run(loaded: &Loaded, opts: &JobOptions, control: &dyn RunControl) -> Resu
 }
 
 /// [`run`] on the ranks of `comm` (a run started by `mpirun`). Every rank calls it and every rank returns
-/// an error when one does. Kinds that are not split over ranks ([`crate::Scenario::runs_on_ranks`]) and
-/// `--resume` are refused on several ranks before the run folder is touched; one rank is the ordinary
-/// run. On several ranks rank 0 alone prepares the folder, writes `run.toml`, `log.txt`, `summary.json`
-/// and the report; the others learn the outcome of each of these from it.
+/// an error when one does. Kinds that are not split over ranks ([`crate::Scenario::runs_on_ranks`]) are
+/// refused on several ranks before the run folder is touched; one rank is the ordinary run. On several
+/// ranks rank 0 alone prepares the folder, writes `run.toml`, `log.txt`, `summary.json` and the report;
+/// the others learn the outcome of each of these from it. A resume needs a checkpoint written by as many
+/// ranks as this run has, or [`JobOptions::repartition`] (see [`spatter_io::rank_checkpoint`]).
 pub fn run_with_comm(
     loaded: &Loaded,
     opts: &JobOptions,
     control: &dyn RunControl,
     comm: &dyn Comm,
 ) -> Result<RunSummary, JobError> {
-    if comm.size() > 1 {
-        if !loaded.scenario.runs_on_ranks() {
-            let split: Vec<String> =
-                KIND_RANKS.iter().filter(|k| k.1).map(|k| format!("`{}`", k.0)).collect();
-            return Err(JobError::Ranks(format!(
-                "started on {} ranks, but kind `{}` runs in one process (kinds split over MPI ranks: {}); \
-                 start it without mpirun, with --threads for the cores of this machine",
-                comm.size(),
-                loaded.scenario.kind(),
-                split.join(", ")
-            )));
-        }
-        if opts.resume {
-            return Err(JobError::Ranks(format!(
-                "started on {} ranks with --resume: runs on several ranks write no checkpoint yet, and a \
-                 checkpoint of one process resumes in one process; resume without mpirun",
-                comm.size()
-            )));
-        }
+    if comm.size() > 1 && !loaded.scenario.runs_on_ranks() {
+        let split: Vec<String> = KIND_RANKS.iter().filter(|k| k.1).map(|k| format!("`{}`", k.0)).collect();
+        return Err(JobError::Ranks(format!(
+            "started on {} ranks, but kind `{}` runs in one process (kinds split over MPI ranks: {}); \
+             start it without mpirun, with --threads for the cores of this machine",
+            comm.size(),
+            loaded.scenario.kind(),
+            split.join(", ")
+        )));
+    }
+    if opts.repartition && !opts.resume {
+        return Err(JobError::Folder("--repartition continues a checkpoint: it needs --resume".into()));
+    }
+    if opts.repartition && !loaded.scenario.runs_on_ranks() {
+        return Err(JobError::Folder(format!(
+            "--repartition: kind `{}` runs in one process and its checkpoints are never split over ranks; \
+             resume without --repartition",
+            loaded.scenario.kind()
+        )));
     }
     if !(opts.checkpoint_interval_s > 0.0 && opts.checkpoint_interval_s.is_finite()) {
         return Err(JobError::Folder(format!(
@@ -137,7 +142,7 @@ pub fn run_with_comm(
     if comm.size() > 1 {
         return run_on_ranks(loaded, opts, control, comm, &resolved, hash);
     }
-    let dir = prepare_folder(opts, hash)?;
+    let dir = prepare_folder(opts, hash, comm.size())?;
     dir.write_text("run.toml", &resolved)?;
     let earlier_wall_s = if opts.resume { earlier_wall_time(&dir) } else { 0.0 };
     // The job's log; whatever log was open before (a study's own) is open again afterwards.
@@ -185,7 +190,7 @@ fn run_on_ranks(
 ) -> Result<RunSummary, JobError> {
     let root = comm.is_root();
     let prepared = root.then(|| {
-        let dir = prepare_folder(opts, hash)?;
+        let dir = prepare_folder(opts, hash, comm.size())?;
         dir.write_text("run.toml", resolved)?;
         Ok(dir)
     });
@@ -195,25 +200,42 @@ fn run_on_ranks(
         None => RunDir::create(&opts.out)?,
     };
     let previous_log = spatter_io::runlog::current();
+    let earlier_wall_s = if opts.resume && root { earlier_wall_time(&dir) } else { 0.0 };
+    if !root {
+        // Created by the first line only: a rank with nothing to say leaves no file.
+        spatter_io::runlog::open_when_written(&dir.root().join(rank_log(comm.rank())), opts.resume);
+    }
     if root {
-        spatter_io::runlog::open(&dir.root().join("log.txt"), false)?;
+        spatter_io::runlog::open(&dir.root().join("log.txt"), opts.resume)?;
         tracing::info!(
-            "spatter {} {} scenario {} → {} on {} ranks × {} thread(s)",
+            "spatter {} {} scenario {} → {} on {} ranks × {} thread(s){}",
             env!("CARGO_PKG_VERSION"),
             loaded.scenario.kind(),
             loaded.source.path.display(),
             dir.root().display(),
             comm.size(),
-            rayon::current_num_threads()
+            rayon::current_num_threads(),
+            match (opts.resume, opts.repartition) {
+                (true, true) => " (resumed, re-partitioned)",
+                (true, false) => " (resumed)",
+                _ => "",
+            }
         );
     }
     let timed = Timed::new(control, Duration::from_secs_f64(opts.checkpoint_interval_s));
-    let ctx = RunContext { dir: &dir, control: &timed, resume: false, input_hash: hash, comm };
+    let ctx = RunContext {
+        dir: &dir,
+        control: &timed,
+        resume: opts.resume,
+        input_hash: hash,
+        comm,
+        repartition: opts.repartition,
+    };
     let started = Instant::now();
     // The scenario's errors are collective (every rank returns the same one); a failed write on one rank
     // ends the whole run there.
     let result = loaded.scenario.run(&ctx).map_err(JobError::Run);
-    let wall = started.elapsed().as_secs_f64();
+    let wall = earlier_wall_s + started.elapsed().as_secs_f64();
     let result = match result {
         Ok(summary) => {
             let written = root.then(|| {
@@ -226,7 +248,9 @@ fn run_on_ranks(
                     Finished::Completed => {
                         tracing::info!("completed in {wall:.3} s on {} ranks", comm.size())
                     }
-                    Finished::Interrupted => tracing::info!("interrupted after {wall:.3} s"),
+                    Finished::Interrupted => {
+                        tracing::info!("interrupted after {wall:.3} s; checkpoint written")
+                    }
                 }
                 Ok(())
             });
@@ -234,16 +258,36 @@ fn run_on_ranks(
         }
         Err(e) => Err(e),
     };
+    // Which ranks wrote a log of their own (every rank reaches this point: the outcomes above are
+    // collective).
+    let logged = comm.all_gather_bytes(&[u8::from(!root && spatter_io::runlog::written())]);
     if root {
+        let files: Vec<String> = logged
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.first() == Some(&1))
+            .map(|(r, _)| rank_log(r))
+            .collect();
+        if !files.is_empty() {
+            tracing::warn!(
+                "ranks other than 0 logged messages (warnings among them?): see {}",
+                files.join(", ")
+            );
+        }
         if let Err(e) = &result {
             tracing::error!("{e}");
         }
-        spatter_io::runlog::close();
-        if let Some(p) = previous_log {
-            spatter_io::runlog::open(&p, true)?;
-        }
+    }
+    spatter_io::runlog::close();
+    if let Some(p) = previous_log {
+        spatter_io::runlog::open(&p, true)?;
     }
     result
+}
+
+/// The log of rank `rank` (> 0) of a run on several ranks, relative to the run folder.
+pub fn rank_log(rank: usize) -> String {
+    format!("ranks/log_r{rank:04}.txt")
 }
 
 fn run_in(
@@ -265,7 +309,14 @@ fn run_in(
     );
     tracing::info!("threads: {}", rayon::current_num_threads());
     let timed = Timed::new(control, Duration::from_secs_f64(opts.checkpoint_interval_s));
-    let ctx = RunContext { dir, control: &timed, resume: opts.resume, input_hash: hash, comm };
+    let ctx = RunContext {
+        dir,
+        control: &timed,
+        resume: opts.resume,
+        input_hash: hash,
+        comm,
+        repartition: opts.repartition,
+    };
     let started = Instant::now();
     let summary = loaded.scenario.run(&ctx).map_err(JobError::Run)?;
     let wall = earlier_wall_s + started.elapsed().as_secs_f64();
@@ -281,8 +332,9 @@ fn run_in(
     Ok(summary)
 }
 
-/// Creates (or checks) the run folder.
-fn prepare_folder(opts: &JobOptions, hash: u64) -> Result<RunDir, JobError> {
+/// Creates (or checks) the run folder of a run on `ranks` ranks. A checkpoint to resume must be intact,
+/// of this input, and written by as many ranks unless `opts.repartition`.
+fn prepare_folder(opts: &JobOptions, hash: u64, ranks: usize) -> Result<RunDir, JobError> {
     let (out, resume, overwrite) = (opts.out.as_path(), opts.resume, opts.overwrite);
     if out.exists() && !out.is_dir() {
         return Err(JobError::Folder(format!("output {} exists and is not a folder", out.display())));
@@ -296,7 +348,12 @@ fn prepare_folder(opts: &JobOptions, hash: u64) -> Result<RunDir, JobError> {
                 out.display()
             )));
         }
-        spatter_io::checkpoint::verify(&checkpoint, hash).map_err(|e| JobError::Resume(e.to_string()))?;
+        let written = spatter_io::checkpoint::written_by(&checkpoint, hash)
+            .map_err(|e| JobError::Resume(e.to_string()))?;
+        if written != ranks && !opts.repartition {
+            let e = spatter_io::checkpoint::CheckpointError::RankCount { path: checkpoint, written, ranks };
+            return Err(JobError::Resume(e.to_string()));
+        }
         return Ok(RunDir::create(out)?);
     }
     let entries: Vec<PathBuf> = match std::fs::read_dir(out) {

@@ -164,6 +164,13 @@ impl Simulation {
         let rank = comm.rank();
         let keep: Vec<bool> = self.fluid.pos.iter().map(|&x| rcb.owner(x) == rank).collect();
         self.fluid.retain(&keep);
+        self.install_partition(rcb, comm);
+        Ok(())
+    }
+
+    /// Takes `rcb` as the split of space over the ranks of `comm` (boxes, neighbours, empty halo lists).
+    fn install_partition(&mut self, rcb: Rcb, comm: &dyn Comm) {
+        let rank = comm.rank();
         let width = HALO_SUPPORTS * self.kernel().support();
         let peers = rcb.peers(rank, width);
         let mut peer_ranks: Vec<usize> = peers.iter().map(|p| p.rank).collect();
@@ -182,6 +189,96 @@ impl Simulation {
             last_migrants: 0,
         });
         self.work.ready = false;
+    }
+
+    /// The split of space over the ranks (`None` on one rank): a checkpoint of a run on ranks saves it
+    /// beside each rank's state, so that a resume on the same ranks continues with the same boxes.
+    pub fn partition(&self) -> Option<&Rcb> {
+        self.decomp.as_ref().map(|d| &d.rcb)
+    }
+
+    /// Continues a rank's state loaded from a checkpoint written on the same ranks: takes `rcb` (its
+    /// [`Self::partition`] then) as the split and rebuilds the scratch state ([`Self::refresh_with`]).
+    /// Collective. The run then goes on bit for bit as if it had not stopped.
+    pub fn restore_partition(&mut self, rcb: Rcb, comm: &dyn Comm) -> Result<(), SphError> {
+        if rcb.ranks() != comm.size() {
+            return Err(SphError::Setup(format!(
+                "the checkpoint's split is for {} ranks, this run has {}",
+                rcb.ranks(),
+                comm.size()
+            )));
+        }
+        self.install_partition(rcb, comm);
+        self.refresh_with(comm);
+        Ok(())
+    }
+
+    /// Joins the states of every rank of a checkpointed run (in rank order, each with the split it was
+    /// saved with) into one state that holds every particle, ready to be split afresh over another number
+    /// of ranks ([`Self::decompose`] at the next step, or [`Self::repartition`]). Every wall particle's wet
+    /// flag is the one its owner kept; wet times and plane fluxes are added in rank order and kept only
+    /// where `totals` is true (rank 0), zero elsewhere, so that the collective sums stay right.
+    pub fn join_parts(parts: Vec<(Simulation, Option<Rcb>)>, totals: bool) -> Result<Simulation, SphError> {
+        let mut it = parts.into_iter();
+        let Some((mut sim, _)) = it.next() else {
+            return Err(SphError::Setup("a checkpoint of no ranks".into()));
+        };
+        let mut rest: Vec<(Simulation, Option<Rcb>)> = it.collect();
+        if !rest.is_empty() {
+            let n = sim.boundary.len();
+            if rest.iter().any(|(p, _)| p.boundary.len() != n || p.flux_up.len() != sim.flux_up.len()) {
+                return Err(SphError::Setup("the checkpoint's parts hold different walls".into()));
+            }
+        }
+        // Wet flags: the owner's (rank 0 holds its own in `sim`).
+        if let Some(rcb) = rest.first().and_then(|(_, r)| r.clone()) {
+            for i in 0..sim.boundary.len() {
+                let owner = rcb.owner(sim.boundary.position(i));
+                if owner > 0 {
+                    if let Some((p, _)) = rest.get(owner - 1) {
+                        sim.boundary.wet[i] = p.boundary.wet[i];
+                    }
+                }
+            }
+        }
+        for (p, _) in &mut rest {
+            let f = &mut p.fluid;
+            sim.fluid.pos.append(&mut f.pos);
+            sim.fluid.vel.append(&mut f.vel);
+            sim.fluid.rho.append(&mut f.rho);
+            sim.fluid.acc.append(&mut f.acc);
+            sim.fluid.drho.append(&mut f.drho);
+            sim.fluid.id.append(&mut f.id);
+            sim.fluid.near.append(&mut f.near);
+            sim.fluid.shift.append(&mut f.shift);
+            for (a, b) in sim.boundary.wet_time.iter_mut().zip(&p.boundary.wet_time) {
+                *a += b;
+            }
+            for (a, b) in sim.flux_up.iter_mut().zip(&p.flux_up) {
+                *a += b;
+            }
+            for (a, b) in sim.flux_down.iter_mut().zip(&p.flux_down) {
+                *a += b;
+            }
+        }
+        if !totals {
+            sim.boundary.wet_time.fill(0.0);
+            sim.flux_up.fill(0.0);
+            sim.flux_down.fill(0.0);
+        }
+        sim.decomp = None;
+        sim.work.ready = false;
+        sim.work.walls_built = false;
+        Ok(sim)
+    }
+
+    /// Splits a joined state ([`Self::join_parts`], or a one-rank checkpoint) over the ranks of `comm`
+    /// afresh and rebuilds the scratch state; on one rank only the latter. Collective.
+    pub fn repartition(&mut self, comm: &dyn Comm) -> Result<(), SphError> {
+        if comm.size() > 1 {
+            self.decompose(comm)?;
+        }
+        self.refresh_with(comm);
         Ok(())
     }
 

@@ -442,8 +442,13 @@ impl Simulation {
 
     /// Rebuilds every scratch structure from the state (after loading a checkpoint). Changes no state.
     pub fn refresh(&mut self) {
+        self.refresh_with(&SERIAL)
+    }
+
+    /// [`Self::refresh`] on the ranks of `comm` (the halo comes from the neighbours). Collective.
+    pub fn refresh_with(&mut self, comm: &dyn Comm) {
         self.boundary.update_kinematics(&self.tree, self.time);
-        self.prepare_sets();
+        self.prepare_sets_with(comm);
         self.wall_state_only();
     }
 

@@ -538,7 +538,7 @@ fn a_run_on_ranks_matches_one_rank() {
         let out = tmp.path().join(format!("ranks{n}"));
         let d = RunDir::create(&out).unwrap();
         let done = ThreadComm::run(n, |comm| {
-            let ctx = RunContext { dir: &d, control: &Unattended, resume: false, input_hash: 0, comm };
+            let ctx = RunContext { comm, ..RunContext::new(&d, &Unattended, false) };
             run(&cfg, &ctx).map(|s| s.finished).map_err(|e| e.to_string())
         });
         assert!(done.iter().all(|f| *f == Ok(Finished::Completed)), "{done:?}");
@@ -579,5 +579,158 @@ fn a_run_on_ranks_matches_one_rank() {
         assert!(out.join("walls.vtu").is_file() && out.join("walls/walls_00005.vtu").is_file());
         let stray: Vec<_> = std::fs::read_dir(out.join("walls")).unwrap().filter_map(|e| e.ok()).collect();
         assert_eq!(stray.len(), 6, "one walls file per output");
+    }
+}
+
+/// Stops after `n` polls like [`StopAfterPolls`] and asks for a checkpoint at every poll before that, so a
+/// run writes one checkpoint generation per step.
+struct CheckpointEveryPoll(StopAfterPolls);
+
+impl spatter_core::control::RunControl for CheckpointEveryPoll {
+    fn stop_requested(&self) -> bool {
+        self.0.stop_requested()
+    }
+    fn checkpoint_due(&self) -> bool {
+        true
+    }
+}
+
+/// Every file under `a` is in `b` with the same bytes, and `b` holds no other file.
+fn same_tree(a: &Path, b: &Path, what: &str) {
+    fn files(root: &Path, dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                files(root, &p, out);
+            } else {
+                out.push(p.strip_prefix(root).unwrap().to_owned());
+            }
+        }
+    }
+    let (mut fa, mut fb) = (Vec::new(), Vec::new());
+    files(a, a, &mut fa);
+    files(b, b, &mut fb);
+    fa.sort();
+    fb.sort();
+    assert_eq!(fa, fb, "{what}: the same files");
+    for f in &fa {
+        assert!(
+            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+            "{what}: {f:?} differs"
+        );
+    }
+}
+
+/// Runs the scenario on `n` thread-ranks into `dir` with a control per rank; returns every rank's outcome.
+fn run_on_ranks(
+    cfg: &SphConfig,
+    dir: &Path,
+    n: usize,
+    resume: bool,
+    repartition: bool,
+    control: impl Fn() -> Box<dyn spatter_core::control::RunControl> + Sync,
+) -> Vec<Result<Finished, String>> {
+    use spatter_core::comm::ThreadComm;
+    let d = RunDir::create(dir).unwrap();
+    ThreadComm::run(n, |comm| {
+        let c = control();
+        let ctx = RunContext { comm, repartition, ..RunContext::new(&d, c.as_ref(), resume) };
+        run(cfg, &ctx).map(|s| s.finished).map_err(|e| e.to_string())
+    })
+}
+
+/// A run on two thread-ranks stopped part-way (after writing a checkpoint at every step, so old
+/// generations are deleted as new ones are complete) and resumed on two ranks leaves every file, byte for
+/// byte, as the uninterrupted two-rank run: each rank continues from its own part with the same split.
+#[test]
+fn a_run_on_two_ranks_resumes_bit_for_bit() {
+    let text = SMALL.replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwall_particles = true");
+    let cfg = config(&text);
+    let tmp = tempfile::tempdir().unwrap();
+    let (full, split) = (tmp.path().join("full"), tmp.path().join("split"));
+    let done = run_on_ranks(&cfg, &full, 2, false, false, || Box::new(Unattended));
+    assert!(done.iter().all(|f| *f == Ok(Finished::Completed)), "{done:?}");
+    let stopped = run_on_ranks(&cfg, &split, 2, false, false, || {
+        Box::new(CheckpointEveryPoll(StopAfterPolls::new(60)))
+    });
+    assert!(stopped.iter().all(|f| *f == Ok(Finished::Interrupted)), "{stopped:?}");
+    assert!(split.join("checkpoint.bin").is_file());
+    let mut parts: Vec<String> = std::fs::read_dir(split.join("checkpoint"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    parts.sort();
+    // 61 checkpoints (one per poll, the last at the stop): generations 0–60, only the last one kept.
+    assert_eq!(parts, ["part_g000060_r0000.bin", "part_g000060_r0001.bin"]);
+    let resumed = run_on_ranks(&cfg, &split, 2, true, false, || Box::new(Unattended));
+    assert!(resumed.iter().all(|f| *f == Ok(Finished::Completed)), "{resumed:?}");
+    assert!(!split.join("checkpoint.bin").exists() && !split.join("checkpoint").exists());
+    same_tree(&full, &split, "two ranks, stopped and resumed on two");
+}
+
+/// The largest difference of every `series.csv` column of `dir` from the one-rank run `rows1`, within
+/// 10⁻⁶ of the column's scale; particle and step counts exact.
+fn series_within_round_off(dir: &Path, cols: &[String], rows1: &[Vec<f64>], what: &str) {
+    let (cols_n, rows) = spatter_io::csv::read_series(&dir.join("series.csv")).unwrap();
+    assert_eq!(cols_n, cols, "{what}");
+    assert_eq!(rows.len(), rows1.len(), "{what}");
+    for (c, name) in cols.iter().enumerate() {
+        let col = |rs: &[Vec<f64>]| rs.iter().map(|r| r[c]).collect::<Vec<f64>>();
+        let (a, b) = (col(rows1), col(&rows));
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+        let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        if name == "particles" || name == "step" {
+            assert_eq!(worst, 0.0, "{what}, column {name}");
+        }
+        assert!(worst <= 1e-6 * scale, "{what}, column {name}: off by {worst:e} of {scale:e}");
+    }
+}
+
+/// A checkpoint resumed on another rank count: refused on every rank with one sentence without
+/// `repartition`; with it, a two-rank checkpoint continues on one and on three ranks, and a one-rank
+/// checkpoint on two. Tolerance: 10⁻⁶ of each `series.csv` column's scale against the uninterrupted
+/// one-rank run, the same as for uninterrupted runs on several ranks (`a_run_on_ranks_matches_one_rank`):
+/// a re-partitioned run sums forces in another order after the resume (pairs across rank cuts are
+/// evaluated in double precision, the others in single precision), so it differs at that rounding;
+/// particle counts, steps and times exact.
+#[test]
+fn a_checkpoint_resumes_on_another_rank_count_with_repartition() {
+    let cfg = config(SMALL);
+    let tmp = tempfile::tempdir().unwrap();
+    let one = tmp.path().join("one");
+    run_to_end(&cfg, &one);
+    let (cols, rows1) = spatter_io::csv::read_series(&one.join("series.csv")).unwrap();
+    let stop = || -> Box<dyn spatter_core::control::RunControl> { Box::new(StopAfterPolls::new(60)) };
+    let go = || -> Box<dyn spatter_core::control::RunControl> { Box::new(Unattended) };
+    for (from, to) in [(2usize, 1usize), (2, 3), (1, 2)] {
+        let what = format!("{from} → {to} ranks");
+        let dir = tmp.path().join(format!("from{from}to{to}"));
+        let stopped = run_on_ranks(&cfg, &dir, from, false, false, stop);
+        assert!(stopped.iter().all(|f| *f == Ok(Finished::Interrupted)), "{what}: {stopped:?}");
+        let refused = run_on_ranks(&cfg, &dir, to, true, false, go);
+        let sentence = format!(
+            "written by {from} rank{} and this run has {to} rank{}: add --repartition",
+            if from > 1 { "s" } else { "" },
+            if to > 1 { "s" } else { "" }
+        );
+        for r in &refused {
+            let e = r.as_ref().unwrap_err();
+            assert!(e.contains(&sentence), "{what}: {e}");
+        }
+        let resumed = run_on_ranks(&cfg, &dir, to, true, true, go);
+        assert!(resumed.iter().all(|f| *f == Ok(Finished::Completed)), "{what}: {resumed:?}");
+        series_within_round_off(&dir, &cols, &rows1, &what);
+        for table in ["wetting.csv", "splash_height.csv"] {
+            let t1 = std::fs::read_to_string(one.join(table)).unwrap();
+            let tn = std::fs::read_to_string(dir.join(table)).unwrap();
+            let nums =
+                |t: &str| -> Vec<f64> { t.split([',', '\n']).filter_map(|v| v.parse().ok()).collect() };
+            let (a, b) = (nums(&t1), nums(&tn));
+            assert_eq!(a.len(), b.len(), "{what}: {table}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-9), "{what}, {table}: {y} vs {x}");
+            }
+        }
+        assert!(!dir.join("checkpoint.bin").exists() && !dir.join("checkpoint").exists(), "{what}");
     }
 }

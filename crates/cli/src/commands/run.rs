@@ -28,6 +28,8 @@ pub struct RunArgs {
     pub threads: Option<usize>,
     pub resume: bool,
     pub overwrite: bool,
+    /// With `resume`: continue on another rank count than the checkpoint's (`--repartition`).
+    pub repartition: bool,
     pub checkpoint_interval_s: f64,
     pub verbose: u8,
     pub quiet: bool,
@@ -42,6 +44,7 @@ impl Default for RunArgs {
             threads: None,
             resume: false,
             overwrite: false,
+            repartition: false,
             checkpoint_interval_s: job::DEFAULT_CHECKPOINT_INTERVAL_S,
             verbose: 0,
             quiet: false,
@@ -138,6 +141,7 @@ fn execute(
         overwrite: args.overwrite,
         checkpoint_interval_s: args.checkpoint_interval_s,
         keep: Vec::new(),
+        repartition: args.repartition,
     };
     let started = Instant::now();
     let result = job::run_with_comm(&loaded, &opts, &control, comm);

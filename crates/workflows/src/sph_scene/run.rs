@@ -2,23 +2,31 @@
 //!
 //! On several ranks (`ctx.comm`, a run under `mpirun`) every rank steps its share of the fluid and joins
 //! every collective sensor; rank 0 alone writes `series.csv`, the `.pvd`, the `.pvtu` of each output, the
-//! walls, maps and tables; every rank writes its own piece of the particle output. Such runs write no
-//! checkpoint yet.
+//! walls, maps and tables; every rank writes its own piece of the particle output.
+//!
+//! Checkpoints: one rank writes its whole [`SceneState`] into `checkpoint.bin` (the format of one-rank
+//! runs, unchanged). Several ranks write one part each ([`RankPart`]: the rank's state with its share of
+//! the fluid and of the partial sums, and the split of space) and rank 0 a manifest
+//! ([`spatter_io::rank_checkpoint`]). A resume on as many ranks continues bit for bit; with
+//! `--repartition` the parts (or a one-rank checkpoint) are joined and split afresh over the ranks of the
+//! new run, which then differs from an uninterrupted run at round-off level.
 
 use super::build::{build_with, BuildInfo};
 use super::config::SphConfig;
 use serde::{Deserialize, Serialize};
 use spatter_core::comm::Comm;
 use spatter_core::control::Finished;
+use spatter_core::rcb::Rcb;
 use spatter_core::Vec3;
 use spatter_io::csv::{write_table, CsvSeries};
 use spatter_io::pvd::PvdSeries;
+use spatter_io::rank_checkpoint::Resumed;
 use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use spatter_sph::error::SphError;
 use spatter_sph::sim::Simulation;
 use spatter_sph::wetting::{default_view, particle_map, wet_area, wetting_map};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// Everything a resumed run needs besides the configuration.
@@ -38,6 +46,84 @@ struct SceneState {
     flux_down: Vec<f64>,
     /// Wall-clock seconds of earlier sessions.
     wall_seconds: f64,
+}
+
+/// One rank's part of a checkpoint written on several ranks: its state (its own fluid; wet times, height
+/// volumes and plane fluxes as this rank's partial sums; the series and `.pvd` counters of rank 0) and the
+/// split of space it steps in.
+#[derive(Deserialize)]
+struct RankPart {
+    scene: SceneState,
+    partition: Option<Rcb>,
+}
+
+/// [`RankPart`] as written (borrowing the running state; the same bytes).
+#[derive(Serialize)]
+struct RankPartRef<'a> {
+    scene: &'a SceneState,
+    partition: Option<&'a Rcb>,
+}
+
+/// The state to continue from, on the ranks of `ctx.comm` (collective; see the module docs).
+fn resumed_state(ctx: &RunContext) -> Result<SceneState, SphError> {
+    let comm = ctx.comm;
+    Ok(match ctx.load_checkpoint_parts::<SceneState, RankPart>()? {
+        Resumed::Whole(mut st) if comm.size() == 1 => {
+            st.sim.refresh();
+            st
+        }
+        Resumed::Whole(st) => rejoin(vec![(st, None)], comm)?,
+        Resumed::Mine(RankPart { mut scene, partition }) => {
+            let rcb = partition.ok_or_else(|| {
+                SphError::Setup("the checkpoint part holds no split of space over the ranks".into())
+            })?;
+            scene.sim.restore_partition(rcb, comm)?;
+            scene
+        }
+        Resumed::All(parts) => rejoin(parts.into_iter().map(|p| (p.scene, p.partition)).collect(), comm)?,
+    })
+}
+
+/// Joins the states of the ranks that wrote a checkpoint (in their rank order) and splits them over the
+/// ranks of `comm`: rank 0 takes the sums of the partial sums, the others start theirs from zero.
+fn rejoin(parts: Vec<(SceneState, Option<Rcb>)>, comm: &dyn Comm) -> Result<SceneState, SphError> {
+    let totals = comm.is_root();
+    let mut sims = Vec::with_capacity(parts.len());
+    let mut first: Option<SceneState> = None;
+    for (st, rcb) in parts {
+        let (sim, rest) = st.split_sim();
+        sims.push((sim, rcb));
+        match first.as_mut() {
+            None => first = Some(rest),
+            Some(f) => {
+                for (a, b) in [
+                    (&mut f.height_volume_time, &rest.height_volume_time),
+                    (&mut f.flux_up, &rest.flux_up),
+                    (&mut f.flux_down, &rest.flux_down),
+                ] {
+                    a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+                }
+            }
+        }
+    }
+    let mut st = first.ok_or_else(|| SphError::Setup("a checkpoint of no ranks".into()))?;
+    if !totals {
+        for v in [&mut st.height_volume_time, &mut st.flux_up, &mut st.flux_down] {
+            v.fill(0.0);
+        }
+    }
+    st.sim = Simulation::join_parts(sims, totals)?;
+    st.sim.repartition(comm)?;
+    Ok(st)
+}
+
+impl SceneState {
+    /// Takes the simulation out (leaving an empty one) to hand it to [`Simulation::join_parts`].
+    fn split_sim(mut self) -> (Simulation, SceneState) {
+        let params = self.sim.params.clone();
+        let sim = std::mem::replace(&mut self.sim, Simulation::new(params));
+        (sim, self)
+    }
 }
 
 /// Column names of `series.csv`.
@@ -205,24 +291,28 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
     let series_path = dir.path("series.csv");
     let pvd_path = dir.path("particles.pvd");
     let session = Instant::now();
-    if ranks && ctx.resume {
-        return Err(SphError::Setup(format!(
-            "resuming on {} ranks is not possible yet (runs on several ranks write no checkpoint); resume \
-             without mpirun",
-            comm.size()
-        )));
-    }
-    // Rank 0 alone writes the series and the .pvd.
-    let (mut st, mut series, mut pvd) = if ctx.resume && ckpt.exists() {
-        let mut st: SceneState = ctx.load_checkpoint()?;
-        st.sim.refresh();
-        let cols = series_columns(cfg, &st.sim);
-        let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
-        let series = CsvSeries::resume(&series_path, &cols, st.series_bytes).map_err(io_at(&series_path))?;
-        let mut pvd = PvdSeries::load_or_new(&pvd_path).map_err(io_at(&pvd_path))?;
-        pvd.truncate_after(st.sim.time).map_err(io_at(&pvd_path))?;
-        tracing::info!("resumed at t = {:.6} s, step {}", st.sim.time, st.sim.steps);
-        (st, Some(series), Some(pvd))
+    // Rank 0 alone writes the series and the .pvd. On several ranks the job driver has checked that the
+    // checkpoint exists (every rank must take the same branch).
+    let (mut st, mut series, mut pvd) = if ctx.resume && (ranks || ckpt.exists()) {
+        let st = resumed_state(ctx)?;
+        let (series, pvd) = if root {
+            let cols = series_columns(cfg, &st.sim);
+            let cols: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+            let series =
+                CsvSeries::resume(&series_path, &cols, st.series_bytes).map_err(fatal(comm, &series_path))?;
+            let mut pvd = PvdSeries::load_or_new(&pvd_path).map_err(fatal(comm, &pvd_path))?;
+            pvd.truncate_after(st.sim.time).map_err(fatal(comm, &pvd_path))?;
+            tracing::info!(
+                "resumed at t = {:.6} s, step {}{}",
+                st.sim.time,
+                st.sim.steps,
+                if ranks { format!(" on {} ranks", comm.size()) } else { String::new() }
+            );
+            (Some(series), Some(pvd))
+        } else {
+            (None, None)
+        };
+        (st, series, pvd)
     } else {
         let (sim, info) = build_with(cfg, comm)?;
         if root {
@@ -279,7 +369,6 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
     let vtu_dt = cfg.output.vtu_interval();
     let sample_dt = cfg.output.sample_interval();
     let total_steps_estimate = (end / st.sim.dt.max(1e-12)) as u64;
-    let mut checkpoint_skipped = false;
     loop {
         // Outputs due at the current time.
         if st.sim.time >= st.next_sample - 1e-12 * end {
@@ -338,54 +427,35 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
         if st.sim.time >= end - 1e-12 * end {
             break;
         }
-        if ranks {
-            // A stop request reaches the ranks at different moments: any rank's request stops all of them
-            // after the same step. No checkpoint on several ranks yet.
-            let mut stop = [if ctx.control.stop_requested() { 1.0 } else { 0.0 }];
-            comm.all_max_f64(&mut stop);
-            if root && !checkpoint_skipped && ctx.checkpoint_due() {
-                tracing::warn!(
-                    "runs on {} ranks write no checkpoint yet; periodic checkpoints are skipped",
-                    comm.size()
-                );
-                checkpoint_skipped = true;
-            }
-            if stop[0] > 0.0 {
-                if let Some(series) = series.as_mut() {
-                    series.flush().map_err(fatal(comm, &series_path))?;
-                }
-                let mut s = RunSummary::new(Finished::Interrupted);
-                s.headline.push(format!(
-                    "stopped at t = {:.6} s of {end} s; runs on several ranks write no checkpoint yet, so this one \
-                     cannot be resumed",
-                    st.sim.time
-                ));
-                return Ok(s);
-            }
-        } else {
-            let stop = ctx.control.stop_requested();
-            if stop || ctx.checkpoint_due() {
-                let series = series.as_mut().expect("one rank writes the series");
-                series.flush().map_err(io_at(&series_path))?;
+        let poll = ctx.poll();
+        if poll.stop || poll.checkpoint {
+            if let Some(series) = series.as_mut() {
+                series.flush().map_err(fatal(comm, &series_path))?;
                 st.series_bytes = series.bytes_written();
-                // The checkpoint holds the wall time up to now; this session's count goes on from here.
-                let earlier = st.wall_seconds;
-                st.wall_seconds += session.elapsed().as_secs_f64();
+            }
+            // The checkpoint holds the wall time up to now; this session's count goes on from here.
+            let earlier = st.wall_seconds;
+            st.wall_seconds += session.elapsed().as_secs_f64();
+            if ranks {
+                ctx.save_checkpoint_part(&RankPartRef { scene: &st, partition: st.sim.partition() })?;
+            } else {
                 ctx.save_checkpoint(&st)?;
-                if stop {
+            }
+            if poll.stop {
+                if root {
                     tracing::info!(
                         "stopped at t = {:.6} s, step {}; checkpoint written",
                         st.sim.time,
                         st.sim.steps
                     );
-                    let mut s = RunSummary::new(Finished::Interrupted);
-                    s.headline
-                        .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
-                    s.artifacts.push(("checkpoint".into(), ckpt));
-                    return Ok(s);
                 }
-                st.wall_seconds = earlier;
+                let mut s = RunSummary::new(Finished::Interrupted);
+                s.headline
+                    .push(format!("stopped at t = {:.6} s of {end} s; resume to continue", st.sim.time));
+                s.artifacts.push(("checkpoint".into(), ckpt));
+                return Ok(s);
             }
+            st.wall_seconds = earlier;
         }
         st.sim.step_with(comm)?;
         accumulate_height(cfg, &mut st);
@@ -636,9 +706,6 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> R
     summary.headline.push(cost);
     summary.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
     summary.artifacts.push(("time series".into(), dir.path("series.csv")));
-    let ckpt: PathBuf = dir.checkpoint_path();
-    if ckpt.exists() {
-        std::fs::remove_file(&ckpt).map_err(io_at(&ckpt))?;
-    }
+    spatter_io::rank_checkpoint::remove(dir.root()).map_err(io_at(&dir.checkpoint_path()))?;
     Ok(summary)
 }
