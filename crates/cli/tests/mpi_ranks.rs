@@ -186,7 +186,7 @@ fn strs(a: &[String]) -> Vec<&str> {
     a.iter().map(String::as_str).collect()
 }
 
-/// Two ranks stopped after 40 polls (a checkpoint written at every poll, by both ranks) and resumed on
+/// Two ranks stopped after 15 polls of 37 steps (a checkpoint written at every poll, by both ranks) and
 /// two ranks: every file byte for byte as the uninterrupted two-rank run. The same checkpoint on one rank
 /// is refused without `--repartition` (exit 2, one sentence, nothing changed) and continues with it,
 /// within 10⁻⁶ of each `series.csv` column's scale of the uninterrupted two-rank run (the pairs across the
@@ -200,7 +200,7 @@ fn two_ranks_resume_on_two_and_on_one() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // The second run logs debug messages: rank 1's go to its own log, which rank 0's log names.
     for (dir, log) in [(&split, "info"), (&one, "debug")] {
-        let envs = [("SPATTER_STOP_AFTER_POLLS", "40"), ("RUST_LOG", log)];
+        let envs = [("SPATTER_STOP_AFTER_POLLS", "15"), ("RUST_LOG", log)];
         let o = mpirun_env(2, &strs(&dam_break(dir, &["--checkpoint-interval-s", "1e-9"])), &envs);
         assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
         assert!(dir.join("checkpoint.bin").is_file());
