@@ -186,7 +186,7 @@ fn strs(a: &[String]) -> Vec<&str> {
     a.iter().map(String::as_str).collect()
 }
 
-/// Two ranks stopped after 15 polls of 37 steps (a checkpoint written at every poll, by both ranks) and
+/// Two ranks stopped after 15 polls of 37 steps (a checkpoint written at every poll, by both ranks) and resumed on
 /// two ranks: every file byte for byte as the uninterrupted two-rank run. The same checkpoint on one rank
 /// is refused without `--repartition` (exit 2, one sentence, nothing changed) and continues with it,
 /// within 10⁻⁶ of each `series.csv` column's scale of the uninterrupted two-rank run (the pairs across the
