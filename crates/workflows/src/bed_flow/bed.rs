@@ -179,11 +179,8 @@ impl Validate for DemBedConfig {
                     c.fail("layers", format!("layers = {} must be 1 to 100", self.layers));
                 }
             }
-            (Some(path), None) => {
-                if let Err(e) = read_bed_file(path) {
-                    c.fail("file", e);
-                }
-            }
+            // The bed file is read when the run starts (paths are resolved after validation).
+            (Some(_), None) => {}
         }
         if let Some(k) = self.stiffness_n_m {
             c.positive("stiffness_n_m", k);
@@ -230,6 +227,7 @@ pub struct BedFlowState {
     pub sim: SimState<<BedLaw as spatter_dem::contact::ContactLaw>::State>,
     pub z_ground: f64,
     pub z_release: f64,
+    pub t0: f64,
     pub entrained_count: u64,
     pub entrained_mass: f64,
 }
@@ -241,6 +239,8 @@ pub struct BedFlow {
     pub z_ground: f64,
     /// Centres above this height leave the bed \[m\].
     pub z_release: f64,
+    /// The DEM time at which the flow started (after settling) \[s\].
+    pub t0: f64,
     /// Grains that left the bed so far and their mass \[kg\].
     pub entrained_count: u64,
     pub entrained_mass: f64,
@@ -315,7 +315,8 @@ impl BedFlow {
             sim.add_particle(NewParticle::at(p, r, 0));
         }
         let poured = cfg.file.is_none();
-        let resumed = resume.as_ref().map(|s| (s.z_ground, s.z_release, s.entrained_count, s.entrained_mass));
+        let resumed =
+            resume.as_ref().map(|s| (s.z_ground, s.z_release, s.t0, s.entrained_count, s.entrained_mass));
         if let Some(state) = resume {
             sim.restore(state.sim).map_err(|e| format!("checkpoint of the bed: {e}"))?;
         } else if poured {
@@ -328,7 +329,7 @@ impl BedFlow {
             sim.invalidate();
         }
         let d_max = 2.0 * r_max;
-        let (z_ground, z_release, count, mass) = resumed.unwrap_or_else(|| {
+        let (z_ground, z_release, t0, count, mass) = resumed.unwrap_or_else(|| {
             let top = sim
                 .particles
                 .pos
@@ -339,23 +340,31 @@ impl BedFlow {
             (
                 ground_plane(&sim.particles.pos, &sim.particles.radius),
                 top + cfg.release_height_over_diameter * d_max,
+                sim.time(),
                 0,
                 0.0,
             )
         });
-        let forces = BedFlowForces::new(flow, fluid, density, z_ground, cfg.forces);
+        let mut forces = BedFlowForces::new(flow, fluid, density, z_ground, cfg.forces);
+        forces.t0 = t0;
         let probe = forces.probe.clone();
         sim.set_external_forces(Box::new(forces));
         Ok(BedFlow {
             sim,
             z_ground,
             z_release,
+            t0,
             entrained_count: count,
             entrained_mass: mass,
             probe,
             d_max,
             footprint: [lo.x, hi.x, lo.y, hi.y],
         })
+    }
+
+    /// Time since the flow started \[s\].
+    pub fn flow_time(&self) -> f64 {
+        self.sim.time() - self.t0
     }
 
     /// One DEM step; the grains whose centre rose above [`BedFlow::z_release`] are taken out and returned.
@@ -367,7 +376,7 @@ impl BedFlow {
         for i in 0..p.len() {
             if p.inv_mass[i] > 0.0 && p.pos[i].z > z {
                 out.push(Released {
-                    time: self.sim.time(),
+                    time: self.sim.time() - self.t0,
                     id: p.id[i],
                     diameter: 2.0 * p.radius[i],
                     mass: p.mass(i),
@@ -397,6 +406,7 @@ impl BedFlow {
             sim: self.sim.state(),
             z_ground: self.z_ground,
             z_release: self.z_release,
+            t0: self.t0,
             entrained_count: self.entrained_count,
             entrained_mass: self.entrained_mass,
         }

@@ -88,6 +88,8 @@ pub struct BedFlowForces<G: GroundFlow> {
     pub density: f64,
     /// The flow's ground plane \[m\].
     pub z_ground: f64,
+    /// The DEM time at which the flow starts (the flow's time is the DEM's minus this) \[s\].
+    pub t0: f64,
     pub settings: BedForceSettings,
     /// Last evaluation's friction velocity and exposed count.
     pub probe: Arc<Mutex<BedFlowProbe>>,
@@ -103,6 +105,7 @@ impl<G: GroundFlow> BedFlowForces<G> {
             fluid,
             density,
             z_ground,
+            t0: 0.0,
             settings,
             probe: Arc::default(),
             scratch: ExposureScratch::default(),
@@ -147,7 +150,7 @@ impl<G: GroundFlow> BedFlowForces<G> {
 
 impl<G: GroundFlow> ExternalForces for BedFlowForces<G> {
     fn add(&mut self, time: f64, p: &ParticleView, force: &mut [Vec3], _torque: &mut [Vec3]) {
-        let (u_star, dir) = self.flow.shear(time);
+        let (u_star, dir) = self.flow.shear(time - self.t0);
         self.active.clear();
         self.active.extend(p.inv_mass.iter().map(|&im| im > 0.0));
         let mut exposed = std::mem::take(&mut self.exposed);
@@ -170,7 +173,7 @@ impl<G: GroundFlow> ExternalForces for BedFlowForces<G> {
         let count = exposed.iter().filter(|&&e| e).count();
         self.exposed = exposed;
         if let Ok(mut probe) = self.probe.lock() {
-            *probe = BedFlowProbe { time, u_star, exposed: count };
+            *probe = BedFlowProbe { time: time - self.t0, u_star, exposed: count };
         }
     }
 }

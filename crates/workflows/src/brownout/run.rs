@@ -68,7 +68,7 @@ const BED_COLUMNS: [&str; 6] =
 fn bed_row(b: &BedFlow) -> [f64; 6] {
     let probe = b.probe.lock().map(|p| *p).unwrap_or_default();
     [
-        b.sim.time(),
+        b.flow_time(),
         b.entrained_count as f64,
         b.entrained_mass,
         b.sim.particles.len() as f64,
@@ -532,7 +532,7 @@ fn run_on<F: FlowField, M: FlowField>(
             // the patch's place), with their own velocity.
             let target = ((sim.tracker.state.step + 1) as f64 * dt).min(bed_duration);
             let dtb = b.sim.dt;
-            while b.sim.time() + 0.5 * dtb < target {
+            while b.flow_time() + 0.5 * dtb < target {
                 b.step(&mut released).map_err(|e| BrownoutError::Checkpoint(format!("DEM bed: {e}")))?;
             }
             let [x0, x1, y0, y1] = b.footprint;
@@ -620,7 +620,7 @@ fn run_on<F: FlowField, M: FlowField>(
             cfg.dem_bed.as_ref().map_or(0.0, |c| c.radius_over_radius),
             b.entrained_count,
             b.entrained_mass,
-            b.sim.time(),
+            b.flow_time(),
             probe.u_star,
             b.sim.particles.len(),
             probe.exposed
