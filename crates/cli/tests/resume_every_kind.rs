@@ -385,6 +385,25 @@ fn brownout_resumes_bit_for_bit() {
 }
 
 #[test]
+fn brownout_dem_bed_resumes_bit_for_bit() {
+    // The DEM bed patch under the rotor feeding the cloud: a 6 × 4 × 2 grain patch, 15 cloud steps.
+    let dir = tempfile::tempdir().unwrap();
+    let text = include_str!("../../../examples/brownout_bell47_dem_bed.toml")
+        .replace("tip_vortices = true", "tip_vortices = false")
+        .replace("duration_s = 1.0", "duration_s = 0.03")
+        .replace("duration_s = 0.05", "duration_s = 0.03")
+        .replace("patch_size_m = [2e-3, 1e-3]", "patch_size_m = [0.74e-3, 0.5e-3]")
+        .replace("layers = 3", "layers = 2\nimpact_speed_m_s = 0.5\nsettle_s = 0.002")
+        .replace("release_height_over_diameter = 3.0", "release_height_over_diameter = 0.5")
+        .replace("interval_s = 0.02", "interval_s = 0.004")
+        .replace("grid_cells = [48, 48, 16]", "grid_cells = [8, 8, 4]")
+        .replace("classes = 10", "classes = 4")
+        .replace("[liftoff]", "[liftoff]\npoints = 8");
+    let s = write(dir.path(), "brownout_dem_bed.toml", text.as_bytes());
+    stop_and_resume(&s, 12, "brownout_dem_bed");
+}
+
+#[test]
 fn gravelometer_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     // Four one-sphere stones through a short pipe onto the DIN panel.

@@ -1,6 +1,7 @@
 //! Workflows built on the engines: snow regime maps, DEM scenes, deposition, SPH scenes, flow scenes,
 //! brownout.
 
+pub mod bed_flow;
 pub mod bed_lab;
 pub mod brownout;
 pub mod cfd;

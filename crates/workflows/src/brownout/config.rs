@@ -11,6 +11,8 @@ use spatter_flow::forces::Fluid;
 use spatter_flow::liftoff::entrainment::{EntrainmentModel, Threshold};
 use spatter_flow::liftoff::incipient::{PullOff, RockingSettings};
 
+pub use crate::bed_flow::DemBedConfig;
+
 pub use super::rans::{FlowChoice, RansConfig, RansTurbulence};
 
 /// A `brownout` scenario.
@@ -31,6 +33,21 @@ pub struct BrownoutConfig {
     pub cloud: CloudConfig,
     #[serde(default)]
     pub output: OutputConfig,
+    /// The DEM bed patch under the rotor (with `entrainment.source = "dem_bed"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dem_bed: Option<DemBedConfig>,
+}
+
+/// What feeds the cloud.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EntrainmentSource {
+    /// The empirical model's flux over the annuli (default).
+    #[default]
+    Model,
+    /// The grains that leave a DEM bed patch under the flow (`[dem_bed]`); the model's flux is still
+    /// computed and written for comparison, but releases nothing.
+    DemBed,
 }
 
 fn thesis_air() -> Fluid {
@@ -331,6 +348,9 @@ pub struct EntrainmentConfig {
     /// With tip vortices: times per shedding period over which the flux is averaged.
     #[serde(default = "phases")]
     pub phases: usize,
+    /// What feeds the cloud: the model (default) or the DEM bed patch.
+    #[serde(default)]
+    pub source: EntrainmentSource,
 }
 
 fn phases() -> usize {
@@ -496,6 +516,45 @@ impl Validate for BrownoutConfig {
         c.item("liftoff", &self.liftoff);
         c.item("entrainment", &self.entrainment);
         c.item("cloud", &self.cloud);
+        match (&self.dem_bed, self.entrainment.source) {
+            (None, EntrainmentSource::DemBed) => c.nested("entrainment", |c| {
+                c.fail("source", "source = \"dem_bed\" needs a [dem_bed] table (the bed patch under the rotor)")
+            }),
+            (Some(_), EntrainmentSource::Model) => c.fail(
+                "dem_bed",
+                "[dem_bed] is given but entrainment.source = \"model\"; set entrainment.source = \"dem_bed\" to run the bed patch, or remove [dem_bed]",
+            ),
+            (Some(b), EntrainmentSource::DemBed) => {
+                c.item("dem_bed", b);
+                let (r, w) = (self.rotor.radius_m, self.cloud.domain_radius_over_radius);
+                let reach = b.radius_over_radius * r + b.patch_size_m[0].max(b.patch_size_m[1]);
+                if r > 0.0 && w > 0.0 && reach >= w * r {
+                    c.nested("dem_bed", |c| {
+                        c.fail(
+                            "radius_over_radius",
+                            format!(
+                                "radius_over_radius = {}: the patch (centre {:.3} m from the rotor axis) lies outside the cloud domain, which ends {:.3} m from the axis (cloud.domain_radius_over_radius × R)",
+                                b.radius_over_radius,
+                                b.radius_over_radius * r,
+                                w * r
+                            ),
+                        )
+                    });
+                }
+                if self.cloud.duration_s.is_finite() && b.duration_s > self.cloud.duration_s {
+                    c.nested("dem_bed", |c| {
+                        c.fail(
+                            "duration_s",
+                            format!(
+                                "duration_s = {} s is longer than the cloud's duration_s = {} s",
+                                b.duration_s, self.cloud.duration_s
+                            ),
+                        )
+                    });
+                }
+            }
+            (None, EntrainmentSource::Model) => {}
+        }
         c.nested("output", |c| {
             c.positive("interval_s", self.output.interval_s);
             if self.output.grid_cells.iter().any(|&n| n == 0 || n > 1000) {
@@ -537,6 +596,15 @@ impl spatter_io::run::Smoke for BrownoutConfig {
         self.liftoff.points = self.liftoff.points.min(8);
         self.entrainment.annuli = self.entrainment.annuli.min(6);
         self.entrainment.phases = self.entrainment.phases.min(2);
+        if let Some(b) = &mut self.dem_bed {
+            b.duration_s = b.duration_s.min(self.cloud.duration_s);
+            b.settle_s = Some(b.settle_s.map_or(2e-3, |s| s.min(2e-3)));
+            b.layers = b.layers.min(2);
+            if let Some(d) = b.grain_diameter_m {
+                // At most 6 × 4 grains per layer.
+                b.patch_size_m = [b.patch_size_m[0].min(7.4 * d), b.patch_size_m[1].min(5.0 * d)];
+            }
+        }
         if let FlowChoice::Rans(r) = &mut self.flow {
             r.radial_cells = r.radial_cells.min(16);
             r.axial_cells = r.axial_cells.min(12);

@@ -13,7 +13,8 @@
 //! Stopping (Ctrl-C, SIGTERM) writes `checkpoint.bin` after a whole step; `--resume` continues and gives
 //! the same files as an uninterrupted run.
 
-use super::config::{BrownoutConfig, FlowChoice};
+use super::config::{BrownoutConfig, EntrainmentSource, FlowChoice};
+use crate::bed_flow::{BedFlow, BedFlowState, FieldShear, Released};
 use crate::cfd::SolvedField;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Invalid};
@@ -56,6 +57,36 @@ struct Checkpoint {
     next_output: u64,
     balance_bytes: u64,
     optics_bytes: u64,
+    /// The DEM bed patch and the bytes of its time series (`entrainment.source = "dem_bed"`).
+    bed: Option<BedFlowState>,
+    bed_bytes: u64,
+}
+
+const BED_COLUMNS: [&str; 6] =
+    ["time_s", "entrained_grains", "entrained_kg", "grains_in_bed", "exposed_grains", "u_star_m_s"];
+
+fn bed_row(b: &BedFlow) -> [f64; 6] {
+    let probe = b.probe.lock().map(|p| *p).unwrap_or_default();
+    [
+        b.flow_time(),
+        b.entrained_count as f64,
+        b.entrained_mass,
+        b.sim.particles.len() as f64,
+        probe.exposed as f64,
+        probe.u_star,
+    ]
+}
+
+/// Sampling interval of an unsteady flow over the DEM bed patch \[s\].
+const BED_FLOW_INTERVAL_S: f64 = 1e-3;
+
+/// The key a bed-building error belongs to.
+fn bed_key(b: &crate::bed_flow::DemBedConfig) -> &'static str {
+    if b.file.is_some() {
+        "dem_bed.file"
+    } else {
+        "dem_bed"
+    }
 }
 
 /// Most parcels a run may release (about 1 GB of parcel state).
@@ -323,6 +354,14 @@ fn run_on<F: FlowField, M: FlowField>(
         )?;
         summary.artifacts.push(("entrainment source".into(), path));
     }
+    let model_rate: f64 = rates.iter().flatten().sum();
+    let from_bed = cfg.entrainment.source == EntrainmentSource::DemBed;
+    if from_bed {
+        // The model's flux is written above for comparison; the cloud is fed by the bed patch alone.
+        for v in rates.iter_mut().flatten() {
+            *v = 0.0;
+        }
+    }
     let source = DustSource::new(
         Vec3::ZERO,
         edges,
@@ -334,7 +373,7 @@ fn run_on<F: FlowField, M: FlowField>(
         cfg.cloud.seed,
     );
     let total_rate = source.total_rate();
-    summary.scalar("entrainment_rate_kg_s", total_rate);
+    summary.scalar("entrainment_rate_kg_s", model_rate);
     let parcels = total_rate * cfg.cloud.duration_s / cfg.cloud.parcel_mass_kg;
     if parcels > MAX_PARCELS {
         return Err(BrownoutError::Invalid(vec![Invalid {
@@ -354,6 +393,20 @@ fn run_on<F: FlowField, M: FlowField>(
     let settings =
         TrackSettings { dt, domain: Some(domain), dispersion: None, max_bounces: 8, resort_interval: 0 };
     let model = ForceModel::new(air, ForceSwitches::default());
+    // The DEM bed patch under the flow, centred on the ground at `radius_over_radius`·R on the +x axis;
+    // built (and settled) before the cloud starts.
+    let patch_centre =
+        cfg.dem_bed.as_ref().map_or(Vec3::ZERO, |b| Vec3::new(b.radius_over_radius * r0, 0.0, 0.0));
+    let shear = cfg.dem_bed.as_ref().filter(|_| from_bed).map(|b| {
+        FieldShear {
+            field: &field,
+            centre: patch_centre,
+            max_height: lo.shear_max_height_over_radius * r0,
+            gust: lo.gust_factor,
+            fluid: air,
+        }
+        .tabulate(b.duration_s, BED_FLOW_INTERVAL_S, phases == 1)
+    });
     let mut sim = CloudSim::new(field, model, settings, source);
     let mut grid = CloudGrid::new(domain, cfg.output.grid_cells);
     let lines = &cfg.output.lines_of_sight;
@@ -364,27 +417,53 @@ fn run_on<F: FlowField, M: FlowField>(
     let optics_path = ctx.dir.path("optical_depth.csv");
     let pvd_path = ctx.dir.path("cloud.pvd");
     let ckpt = ctx.dir.checkpoint_path();
+    let bed_path = ctx.dir.path("dem_bed_entrainment.csv");
     let mut next_output = 0u64;
-    let (mut bal_csv, mut opt_csv, mut pvd) = if ctx.resume && ckpt.is_file() {
+    let mut bed_state: Option<BedFlowState> = None;
+    let (mut bal_csv, mut opt_csv, mut pvd, mut bed_csv) = if ctx.resume && ckpt.is_file() {
         // The checkpoint's header carries the input hash: another scenario's checkpoint is refused here.
         let c: Checkpoint = ctx.load_checkpoint().map_err(|e| BrownoutError::Checkpoint(e.to_string()))?;
         sim.tracker.state = c.state;
         sim.source = c.source;
         next_output = c.next_output;
+        bed_state = c.bed;
         let mut pvd = PvdSeries::load_or_new(&pvd_path)?;
         pvd.truncate_after(sim.tracker.state.time)?;
         (
             CsvSeries::resume(&balance_path, &BALANCE_COLUMNS, c.balance_bytes)?,
             CsvSeries::resume(&optics_path, &optics_cols, c.optics_bytes)?,
             pvd,
+            if shear.is_some() {
+                Some(CsvSeries::resume(&bed_path, &BED_COLUMNS, c.bed_bytes)?)
+            } else {
+                None
+            },
         )
     } else {
         (
             CsvSeries::create(&balance_path, &BALANCE_COLUMNS)?,
             CsvSeries::create(&optics_path, &optics_cols)?,
             PvdSeries::new(&pvd_path),
+            if shear.is_some() { Some(CsvSeries::create(&bed_path, &BED_COLUMNS)?) } else { None },
         )
     };
+    let mut bed = match (&cfg.dem_bed, shear) {
+        (Some(b), Some(shear)) => {
+            let built = BedFlow::build(b, rho_p, air, std::sync::Arc::new(shear), bed_state)
+                .map_err(|e| BrownoutError::Invalid(vec![Invalid { key: bed_key(b).into(), message: e }]))?;
+            Some(built)
+        }
+        _ => None,
+    };
+    if let Some(b) = &bed {
+        if sim.tracker.state.step == 0 {
+            let path = ctx.dir.path("dem_bed_start.vtu");
+            spatter_dem::output::write_particles(&b.sim, &path)?;
+            summary.artifacts.push(("DEM bed patch at the start (ParaView)".into(), path));
+        }
+    }
+    let bed_duration = cfg.dem_bed.as_ref().map_or(0.0, |b| b.duration_s);
+    let mut released: Vec<Released> = Vec::new();
     let n_steps = (cfg.cloud.duration_s / dt).round() as u64;
     let interval = cfg.output.interval_s;
     let mut write_outputs = |sim: &CloudSim<F>,
@@ -406,8 +485,15 @@ fn run_on<F: FlowField, M: FlowField>(
         *k += 1;
         Ok(())
     };
+    let write_bed = |bed: &Option<BedFlow>, csv: &mut Option<CsvSeries>| -> std::io::Result<()> {
+        if let (Some(b), Some(csv)) = (bed, csv) {
+            csv.row(&bed_row(b))?;
+        }
+        Ok(())
+    };
     if sim.tracker.state.step == 0 && next_output == 0 {
         write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+        write_bed(&bed, &mut bed_csv)?;
     }
     let due = |t: f64, k: u64| t >= k as f64 * interval - 1e-9 * dt;
     let mut last_written = u64::MAX;
@@ -416,12 +502,17 @@ fn run_on<F: FlowField, M: FlowField>(
         if stop || ctx.checkpoint_due() {
             bal_csv.flush()?;
             opt_csv.flush()?;
+            if let Some(c) = &mut bed_csv {
+                c.flush()?;
+            }
             let c = Checkpoint {
                 state: sim.tracker.state.clone(),
                 source: sim.source.clone(),
                 next_output,
                 balance_bytes: bal_csv.bytes_written(),
                 optics_bytes: opt_csv.bytes_written(),
+                bed: bed.as_ref().map(BedFlow::state),
+                bed_bytes: bed_csv.as_ref().map_or(0, CsvSeries::bytes_written),
             };
             ctx.save_checkpoint(&c).map_err(|e| BrownoutError::Checkpoint(e.to_string()))?;
             if stop {
@@ -435,18 +526,47 @@ fn run_on<F: FlowField, M: FlowField>(
                 return Ok(s);
             }
         }
+        if let Some(b) = &mut bed {
+            // The bed runs over this cloud step; the grains that left it join the cloud at the step's
+            // start, at their place on the ground (bed frame: ground plane at z = 0, patch centre at
+            // the patch's place), with their own velocity.
+            let target = ((sim.tracker.state.step + 1) as f64 * dt).min(bed_duration);
+            let dtb = b.sim.dt;
+            while b.flow_time() + 0.5 * dtb < target {
+                b.step(&mut released).map_err(|e| BrownoutError::Checkpoint(format!("DEM bed: {e}")))?;
+            }
+            let [x0, x1, y0, y1] = b.footprint;
+            let origin = Vec3::new(0.5 * (x0 + x1), 0.5 * (y0 + y1), b.z_ground);
+            for r in released.drain(..) {
+                sim.tracker.add(
+                    spatter_flow::tracker::inject::NewParcel {
+                        pos: patch_centre + (r.pos - origin),
+                        vel: r.vel,
+                        diameter: r.diameter,
+                        density: rho_p,
+                        count: 1.0,
+                    },
+                    0,
+                );
+            }
+        }
         sim.step()?;
         if due(sim.tracker.state.time, next_output) {
             write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+            write_bed(&bed, &mut bed_csv)?;
             last_written = sim.tracker.state.step;
         }
         ctx.control.progress(sim.tracker.state.step, n_steps);
     }
     if last_written != sim.tracker.state.step {
         write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
+        write_bed(&bed, &mut bed_csv)?;
     }
     bal_csv.flush()?;
     opt_csv.flush()?;
+    if let Some(c) = &mut bed_csv {
+        c.flush()?;
+    }
     // A finished run leaves no checkpoint behind.
     if ckpt.exists() {
         std::fs::remove_file(&ckpt)?;
@@ -476,6 +596,39 @@ fn run_on<F: FlowField, M: FlowField>(
         chart = chart.line(&l.name, &pts);
     }
     chart.save_png(&tau_png)?;
+    if let Some(b) = &bed {
+        let path = ctx.dir.path("dem_bed_end.vtu");
+        spatter_dem::output::write_particles(&b.sim, &path)?;
+        summary.artifacts.push(("DEM bed patch at the end (ParaView)".into(), path));
+        let (_, rows) = spatter_io::csv::read_series(&bed_path)?;
+        let col = |k: usize| -> Vec<(f64, f64)> { rows.iter().map(|r| (r[0], r[k])).collect() };
+        let png = ctx.dir.path("dem_bed_entrainment.png");
+        Chart::new(
+            "DEM bed patch: grains that left the bed, and grains exposed to the flow",
+            "time [s]",
+            "grains",
+        )
+        .size(900, 600)
+        .line("entrained (left the bed)", &col(1))
+        .line("exposed to the flow", &col(4))
+        .save_png(&png)?;
+        summary.artifacts.push(("DEM bed entrainment table".into(), bed_path.clone()));
+        summary.artifacts.push(("DEM bed entrainment plot".into(), png));
+        let probe = b.probe.lock().map(|p| *p).unwrap_or_default();
+        summary.headline.push(format!(
+            "DEM bed patch at r/R = {:.2}: {} grains ({:.3e} kg) left the bed in {:.3} s under u* = {:.3} m/s; {} grains remain, {} exposed",
+            cfg.dem_bed.as_ref().map_or(0.0, |c| c.radius_over_radius),
+            b.entrained_count,
+            b.entrained_mass,
+            b.flow_time(),
+            probe.u_star,
+            b.sim.particles.len(),
+            probe.exposed
+        ));
+        summary.scalar("dem_bed_entrained_grains", b.entrained_count as f64);
+        summary.scalar("dem_bed_entrained_kg", b.entrained_mass);
+        summary.scalar("dem_bed_friction_velocity_m_s", probe.u_star);
+    }
     for (label, path) in [
         ("cloud mass balance", balance_path),
         ("entrained mass curve", mass_png),
