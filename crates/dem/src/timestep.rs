@@ -6,7 +6,10 @@
 //!   and the snow thesis recommend Δt ≤ 20 % of t_R;
 //! * Hertz contact duration t_c = 2.868 (m*²/(R* E*² v))^{1/5} at the highest expected impact speed v;
 //!   resolving a contact needs Δt ≤ t_c / 20 (about 20 steps per contact; 50 or more for accurate
-//!   restitution).
+//!   restitution);
+//! * for a linear (Hooke) spring k_n the contact lasts half an undamped period, t_c = π √(m*/k_n)
+//!   (damping lengthens it, so this is the conservative bound); the same 20 steps per contact apply and the
+//!   Rayleigh time is not used, since a soft spring, not the material's elastic waves, sets the step.
 //!
 //! [`check_dt`] returns a warning when Δt exceeds either bound.
 
@@ -35,8 +38,24 @@ pub fn hertz(a: &Material, b: &Material, radius: f64, speed: f64, particle_pair:
     hertz_time(m_eff, r_eff, effective_modulus(a, b), speed.max(1e-9))
 }
 
+/// Undamped linear-spring contact duration t_c = π √(m*/k_n) \[s\] of effective mass `m_eff` \[kg\] on a
+/// spring `k_n` \[N/m\] (half the period of m* on k_n).
+pub fn linear_contact_time(m_eff: f64, k_n: f64) -> f64 {
+    std::f64::consts::PI * (m_eff / k_n).sqrt()
+}
+
+/// Which contact duration a time-step check compares with (named in the warning).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactKind {
+    /// Hertz contact duration ([`hertz`]).
+    Hertz,
+    /// Linear spring contact duration ([`linear_contact_time`]).
+    Linear,
+}
+
 /// A warning when `dt` exceeds [`RAYLEIGH_FRACTION`] of `t_rayleigh` or `t_hertz` / [`STEPS_PER_CONTACT`].
-pub fn check_dt(dt: f64, t_rayleigh: f64, t_hertz: f64) -> Option<String> {
+/// `t_contact` is the shortest contact duration of `kind`.
+pub fn check_dt(dt: f64, t_rayleigh: f64, t_contact: f64, kind: ContactKind) -> Option<String> {
     let mut parts = Vec::new();
     if dt > RAYLEIGH_FRACTION * t_rayleigh {
         parts.push(format!(
@@ -45,11 +64,15 @@ pub fn check_dt(dt: f64, t_rayleigh: f64, t_hertz: f64) -> Option<String> {
             100.0 * RAYLEIGH_FRACTION
         ));
     }
-    if dt > t_hertz / STEPS_PER_CONTACT {
+    if dt > t_contact / STEPS_PER_CONTACT {
+        let name = match kind {
+            ContactKind::Hertz => "fastest Hertz contact",
+            ContactKind::Linear => "shortest linear-spring contact",
+        };
         parts.push(format!(
-            "dt_s = {dt:e} resolves the fastest Hertz contact ({t_hertz:e} s) with only {:.1} steps \
+            "dt_s = {dt:e} resolves the {name} ({t_contact:e} s) with only {:.1} steps \
              (recommended ≥ {STEPS_PER_CONTACT})",
-            t_hertz / dt
+            t_contact / dt
         ));
     }
     (!parts.is_empty()).then(|| parts.join("; "))
@@ -66,9 +89,18 @@ mod tests {
         // Rayleigh time of a 2 mm glass bead: π·1e-3·√(2800/20e9)/(0.1631·0.2 + 0.8766) = 1.2928e-6 s.
         assert!((tr / 1.292843e-6 - 1.0).abs() < 1e-5, "{tr}");
         let tc = hertz(&glass, &glass, 0.001, 1.0, true);
-        assert!(check_dt(0.1 * tr, tr, tc).is_none());
-        let w = check_dt(0.5 * tr, tr, tc).unwrap();
+        assert!(check_dt(0.1 * tr, tr, tc, ContactKind::Hertz).is_none());
+        let w = check_dt(0.5 * tr, tr, tc, ContactKind::Hertz).unwrap();
         assert!(w.contains("Rayleigh"), "{w}");
-        assert!(check_dt(tc / 5.0, f64::INFINITY, tc).unwrap().contains("steps"));
+        assert!(check_dt(tc / 5.0, f64::INFINITY, tc, ContactKind::Hertz).unwrap().contains("Hertz"));
+        assert!(check_dt(tc / 5.0, f64::INFINITY, tc, ContactKind::Linear).unwrap().contains("linear"));
+    }
+
+    #[test]
+    fn linear_contact_time_is_half_the_spring_period() {
+        // m* = 1 g on k = 1e4 N/m: ω = √(k/m) = 3162.3 rad/s, half period π/ω = 9.9346e-4 s (a free
+        // harmonic oscillator).
+        let t = linear_contact_time(1e-3, 1e4);
+        assert!((t / 9.934_588e-4 - 1.0).abs() < 1e-6, "{t}");
     }
 }

@@ -272,3 +272,34 @@ max_m = [0.03, 0.03, 0.06]
     eprintln!("cylinder pour: core packing {phi:.4}, settled at {:.3} s", scalar(&s, "settled_s"));
     assert!((phi - 0.64).abs() < 0.025, "core packing {phi}");
 }
+
+/// The time-step warning of a Hooke scene compares Δt with the linear-spring contact π√(m*/k_n) and not
+/// with the Rayleigh time of the material (which the soft spring makes irrelevant). The box pour: glass
+/// spheres d = 10 mm, m = 1.309 g, k_n = 10⁴ N/m → particle pair m* = 0.654 g, t_c = 8.04·10⁻⁴ s, so
+/// Δt = 4·10⁻⁵ s gives 20.1 steps per contact (no warning) although it is 7 times the Rayleigh time of
+/// glass (5.5·10⁻⁶ s); Δt = 10⁻⁴ s gives 8.0 steps and must warn, naming the linear contact.
+#[test]
+fn hooke_time_step_warning_uses_the_spring() {
+    let warn = |dt: f64| {
+        let mut cfg = parse(&box_pour(10, 4.0, 0.5, 1.0));
+        cfg.dt_s = dt;
+        struct W<'a>(&'a SceneConfig);
+        impl WithLaw for W<'_> {
+            type Output = Vec<String>;
+            fn with<L: spatter_dem::contact::ContactLaw>(
+                self,
+                law: L,
+                built: setup::Built,
+            ) -> Result<Vec<String>, spatter_dem::error::DemError> {
+                let sim = simulation(law, built, self.0);
+                Ok(time_step_warnings(self.0, &sim))
+            }
+        }
+        with_law(&cfg, W(&cfg)).unwrap()
+    };
+    assert!(warn(4e-5).is_empty(), "{:?}", warn(4e-5));
+    let w = warn(1e-4);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("linear-spring contact") && w[0].contains("8.0 steps"), "{}", w[0]);
+    assert!(!w[0].contains("Rayleigh"), "{}", w[0]);
+}

@@ -10,7 +10,7 @@ use spatter_core::{Aabb, Vec3};
 use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
 use spatter_dem::clump::NewBody;
 use spatter_dem::contact::{
-    Composed, ContactLaw, Hertz, Hooke, HookeStiffness, LinearCohesion, LinearHistory, Mindlin,
+    Composed, ContactLaw, Hertz, Hooke, HookeParams, HookeStiffness, LinearCohesion, LinearHistory, Mindlin,
     MindlinVariant, RestitutionDamping,
 };
 use spatter_dem::error::DemError;
@@ -210,6 +210,16 @@ pub trait WithLaw {
     fn with<L: ContactLaw>(self, law: L, built: setup::Built) -> Result<Self::Output, DemError>;
 }
 
+/// The global Hooke stiffness `[contact]` chooses: a constant k_n, or k_n from a characteristic speed
+/// (1 m/s when neither key is given). A pair's own `stiffness_n_m` overrides it.
+fn hooke_stiffness(c: &super::config::ContactConfig) -> HookeStiffness {
+    match (c.hooke_stiffness_n_m, c.hooke_characteristic_speed_m_s) {
+        (Some(k), _) => HookeStiffness::Constant(k),
+        (None, Some(v)) => HookeStiffness::CharacteristicVelocity(v),
+        (None, None) => HookeStiffness::CharacteristicVelocity(1.0),
+    }
+}
+
 /// Builds the scene's engine objects and calls `v` with the contact law `[contact]` chooses (one
 /// monomorphised engine per combination). The scene must have been validated.
 pub fn with_law<V: WithLaw>(cfg: &SceneConfig, v: V) -> Result<V::Output, DemError> {
@@ -220,13 +230,7 @@ pub fn with_law<V: WithLaw>(cfg: &SceneConfig, v: V) -> Result<V::Output, DemErr
         tangential: c.tangential_damping,
     };
     let linear = LinearHistory { stiffness_ratio: c.linear_stiffness_ratio };
-    let hooke = Hooke {
-        stiffness: match (c.hooke_stiffness_n_m, c.hooke_characteristic_speed_m_s) {
-            (Some(k), _) => HookeStiffness::Constant(k),
-            (None, Some(v)) => HookeStiffness::CharacteristicVelocity(v),
-            (None, None) => HookeStiffness::CharacteristicVelocity(1.0),
-        },
-    };
+    let hooke = Hooke { stiffness: hooke_stiffness(c) };
     let jkr = JkrLaw { break_criterion: c.jkr_break, damping: c.jkr_damping, coulomb: c.adhesive_coulomb };
     let r = c.rolling;
     let built = setup::build(cfg)?;
@@ -836,6 +840,11 @@ pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulat
             }
         }
     }
+    if let Some(pour) = &cfg.pour {
+        if let Some(m) = cfg.materials.keys().position(|k| *k == pour.material) {
+            sizes.push((m, 0.5 * setup::min_diameter(&pour.size)));
+        }
+    }
     let mats = sim.materials();
     let mut t_r = f64::INFINITY;
     let mut t_h = f64::INFINITY;
@@ -861,19 +870,37 @@ pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulat
         let vi = cfg.inject.iter().map(|j| j.velocity_m_s.length()).fold(0.0, f64::max);
         (2.0 * cfg.gravity_m_s2.length() * h).sqrt() + v0.max(vi) + 1e-3
     });
+    // Linear springs: the contact lasts π√(m*/k_n) of the pair's own stiffness, and the Rayleigh time
+    // (elastic waves of the material) does not limit the step (docs/dem.md, "Time step").
+    let hooke = (cfg.contact.normal == NormalKind::Hooke).then(|| hooke_stiffness(&cfg.contact));
     let mut seen = std::collections::BTreeSet::new();
     for (m, r) in sizes {
         if !seen.insert((m, r.to_bits())) {
             continue;
         }
-        t_r = t_r.min(timestep::rayleigh(&mats[m], r));
-        t_h = t_h.min(timestep::hertz(&mats[m], &mats[m], r, 2.0 * v, true));
+        let Some(global) = hooke else {
+            t_r = t_r.min(timestep::rayleigh(&mats[m], r));
+            t_h = t_h.min(timestep::hertz(&mats[m], &mats[m], r, 2.0 * v, true));
+            for w in &sim.walls {
+                t_h = t_h.min(timestep::hertz(&mats[m], &mats[w.material as usize], r, v, false));
+            }
+            continue;
+        };
+        let mass = mats[m].density * spatter_core::math::sphere_volume(r);
+        let duration = |b: usize, r_eff: f64, m_eff: f64| {
+            let pp = sim.pair_props(m, b);
+            let stiffness = pp.stiffness.map_or(global, HookeStiffness::Constant);
+            let k = Hooke::stiffness(&HookeParams { e_star: pp.e_star, stiffness }, r_eff, m_eff);
+            timestep::linear_contact_time(m_eff, k)
+        };
+        t_h = t_h.min(duration(m, 0.5 * r, 0.5 * mass));
         for w in &sim.walls {
-            t_h = t_h.min(timestep::hertz(&mats[m], &mats[w.material as usize], r, v, false));
+            t_h = t_h.min(duration(w.material as usize, r, mass));
         }
     }
+    let kind = if hooke.is_some() { timestep::ContactKind::Linear } else { timestep::ContactKind::Hertz };
     let mut out = Vec::new();
-    if let Some(w) = timestep::check_dt(cfg.dt_s, t_r, t_h) {
+    if let Some(w) = timestep::check_dt(cfg.dt_s, t_r, t_h, kind) {
         out.push(w);
     }
     out
