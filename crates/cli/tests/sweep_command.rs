@@ -147,55 +147,58 @@ fn a_folder_of_another_study_is_refused_unless_overwritten() {
 /// Skipped (with a note) where Chromium is not installed, unless `SPATTER_REQUIRE_CHROMIUM=1` (CI).
 #[test]
 fn reports_open_in_a_browser_with_every_picture() {
-    let chromium = ["chromium", "chromium-browser", "google-chrome"]
-        .into_iter()
-        .find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success()));
-    let Some(chromium) = chromium else {
-        assert!(
-            std::env::var("SPATTER_REQUIRE_CHROMIUM").is_err(),
-            "SPATTER_REQUIRE_CHROMIUM is set but no chromium"
-        );
-        eprintln!("note: chromium not installed; report browser check skipped");
-        return;
-    };
+    let Some(chromium) = find_chromium() else { return };
     let dir = tempfile::tempdir().unwrap();
     let study = study_files(dir.path());
     let out = dir.path().join("s");
     ok(&sweep(&[], &study, &out, None));
     for report in [out.join("report.html"), out.join("cases/case_00000/report.html")] {
-        let profile = tempfile::tempdir().unwrap();
-        let o = std::process::Command::new(chromium)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--virtual-time-budget=10000",
-                "--dump-dom",
-            ])
-            .arg(format!("--user-data-dir={}", profile.path().display()))
-            .arg(format!("file://{}", report.display()))
-            .output()
-            .unwrap();
-        let dom = String::from_utf8_lossy(&o.stdout);
-        let body = dom.split("<body").nth(1).and_then(|b| b.split('>').next()).unwrap_or("");
-        let images = body.split("data-images=\"").nth(1).and_then(|s| s.split('"').next()).unwrap_or("?");
-        let (loaded, total) = images.split_once('/').unwrap_or(("?", "?"));
-        assert!(
-            total != "0" && loaded == total,
-            "{}: {images} pictures loaded; body: {body}",
-            report.display()
-        );
-        assert!(
-            body.contains("data-script-errors=\"0\""),
-            "{}: script errors; body: {body}",
-            report.display()
-        );
+        opens_in_browser(chromium, &report);
     }
+}
+
+/// Chromium, when installed; `None` (with a note) otherwise, unless `SPATTER_REQUIRE_CHROMIUM` is set (CI),
+/// where a missing browser fails the test.
+fn find_chromium() -> Option<&'static str> {
+    let chromium = ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success()));
+    if chromium.is_none() {
+        assert!(
+            std::env::var("SPATTER_REQUIRE_CHROMIUM").is_err(),
+            "SPATTER_REQUIRE_CHROMIUM is set but no chromium"
+        );
+        eprintln!("note: chromium not installed; report browser check skipped");
+    }
+    chromium
+}
+
+/// Headless `chromium` opens `report`: every picture decodes and no script error occurs.
+fn opens_in_browser(chromium: &str, report: &Path) {
+    let profile = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--virtual-time-budget=10000",
+            "--dump-dom",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(format!("file://{}", report.display()))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&o.stdout);
+    let body = dom.split("<body").nth(1).and_then(|b| b.split('>').next()).unwrap_or("");
+    let images = body.split("data-images=\"").nth(1).and_then(|s| s.split('"').next()).unwrap_or("?");
+    let (loaded, total) = images.split_once('/').unwrap_or(("?", "?"));
+    assert!(total != "0" && loaded == total, "{}: {images} pictures loaded; body: {body}", report.display());
+    assert!(body.contains("data-script-errors=\"0\""), "{}: script errors; body: {body}", report.display());
 }
 
 /// A deposition study whose two cases differ only in the mass each parcel carries (same seeds, so the same
@@ -236,4 +239,82 @@ fn maps_of_every_case_are_redrawn_on_one_colour_scale() {
     assert!(report.contains("plate deposit: every case on one colour scale"), "gallery heading missing");
     let scale = format!("Colour scale 0 to {}", spatter_io::plot::tick_label(heavy));
     assert!(report.contains(&scale), "expected `{scale}` in the report");
+}
+
+/// A reduced wading study (the shipped truck at a coarse spacing for 6 ms, three variants) writes one
+/// comparison page: every variant named with its values, the wetting maps of every part side by side on
+/// the runs' fixed 0–48 % scale, the splash-height curves and the sensor curves overlaid, the wet fractions
+/// per part and per group with a column per variant, and the cost table; the page opens in a browser.
+#[test]
+fn a_wading_study_writes_one_comparison_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for f in ["wading_truck_body.stl", "wading_truck_wheels.stl", "wading_truck_sensors.stl"] {
+        std::fs::copy(examples.join(f), dir.path().join(f)).unwrap();
+    }
+    let base = std::fs::read_to_string(examples.join("wading_truck.toml"))
+        .unwrap()
+        .replace("spacing_m = 0.05", "spacing_m = 0.12")
+        .replace("wetting_cap = 0.48", "wetting_cap = 0.48\nend_time_s = 0.006\nvtu_interval_s = 0.003");
+    write(dir.path(), "base.toml", base.as_bytes());
+    let study = write(
+        dir.path(),
+        "study.toml",
+        b"title = \"wading variants\"\nbase = \"base.toml\"\ndesign = \"list\"\n\
+          [[vary]]\nkey = \"fluid.spacing_m\"\nvalues = [0.12, 0.12, 0.14]\n\
+          [[vary]]\nkey = \"vehicle.adhesion\"\nvalues = [1.0, 10.0, 1.0]\n\
+          [[vary]]\nkey = \"drag.enabled\"\nvalues = [true, true, false]\n",
+    );
+    let out = dir.path().join("s");
+    ok(&sweep(&[], &study, &out, None));
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let captions = [
+        "case 0: spacing_m = 0.12, adhesion = 1, enabled = true",
+        "case 1: spacing_m = 0.12, adhesion = 10, enabled = true",
+        "case 2: spacing_m = 0.14, adhesion = 1, enabled = false",
+    ];
+    for c in captions {
+        assert!(report.contains(c), "the page must name `{c}`");
+    }
+    for part in ["cab", "chassis", "wheel_fl", "camera_front", "channel_walls"] {
+        for case in 0..3 {
+            let png = out.join(format!("gallery/{part}_wetting/case_{case:05}.png"));
+            assert!(png.is_file(), "{} missing", png.display());
+        }
+        assert!(report.contains(&format!("{part} wetting: every case on one colour scale")), "{part}");
+    }
+    assert!(
+        report.contains(
+            "Colour scale 0 to 0.48 (time wet / elapsed) for every case: the scale every case fixed"
+        ),
+        "the maps keep the runs' fixed wetting cap"
+    );
+    for curve in ["splash_height_distribution", "camera_front_wet_fraction_over_time"] {
+        assert!(out.join(format!("plots/curve_{curve}.png")).is_file(), "{curve} overlay missing");
+    }
+    assert!(report.contains("splash height distribution: every case"));
+    let parts = std::fs::read_to_string(
+        out.join("tables/mean_wet_fraction_per_part__area_fraction__averaged_over_the_run_.csv"),
+    )
+    .unwrap();
+    assert!(parts.starts_with("row,case_0,case_1,case_2\n"), "{parts}");
+    assert!(parts.lines().any(|l| l.starts_with("wheel_fl,")), "{parts}");
+    assert!(report.contains("mean wet fraction per report group (area-weighted): every case"));
+    let cost = std::fs::read_to_string(out.join("cost.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = cost.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        rows[0].join(","),
+        "case,particles,wall_particles,steps,wall_time_s,threads,core_hours,particle_steps_per_s"
+    );
+    for r in &rows[1..] {
+        let n: f64 = r[1].parse().unwrap();
+        let steps: f64 = r[3].parse().unwrap();
+        assert!(n > 1000.0 && steps >= 1.0, "{cost}");
+    }
+    // The coarser case has fewer water particles.
+    assert!(rows[3][1].parse::<f64>().unwrap() < rows[1][1].parse::<f64>().unwrap(), "{cost}");
+    assert!(report.contains("Cost per case"));
+    if let Some(chromium) = find_chromium() {
+        opens_in_browser(chromium, &out.join("report.html"));
+    }
 }

@@ -150,6 +150,11 @@ pub struct RunSummary {
     /// Colour maps on triangle meshes the run drew, with what it takes to draw them again: a study redraws
     /// the same map of every case on one colour scale.
     pub maps: Vec<MeshMapRecord>,
+    /// Curves the run wrote as CSV columns: a study overlays the same curve of every case in one plot.
+    pub curves: Vec<CurveRecord>,
+    /// Named tables of scalars (row label → scalar name), e.g. the wet fraction of every part: a study
+    /// shows each as one table with a column per case.
+    pub scalar_tables: Vec<ScalarTableRecord>,
 }
 
 /// A per-triangle colour map a run drew with [`crate::plot::mesh_map_png`] from a cell array of a triangle
@@ -169,6 +174,38 @@ pub struct MeshMapRecord {
     /// Title and colour-bar label of the picture.
     pub title: String,
     pub colorbar_label: String,
+    /// The fixed colour scale (low, high) the run drew the map on, when the user fixed one (e.g. the
+    /// `wetting_cap` of the `sph` and `wading` kinds); `None` when the run scaled the map to its own values.
+    /// A study draws every case's map on this scale when all cases fixed the same one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<[f64; 2]>,
+}
+
+/// A curve a run wrote as two columns of a CSV table (e.g. a splash-height distribution).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurveRecord {
+    /// Names the curve; the same curve of two runs of a study has the same label.
+    pub label: String,
+    /// The CSV file (relative to the run folder in `summary.json`), with a header row.
+    pub csv: PathBuf,
+    /// Header names of the x and y columns.
+    pub x_column: String,
+    pub y_column: String,
+    /// Axis labels of a plot (name and unit).
+    pub x_label: String,
+    pub y_label: String,
+}
+
+/// A named table of scalars the run reported: one row per entry, the value being the scalar of that name
+/// in [`RunSummary::scalars`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScalarTableRecord {
+    /// Names the table and the quantity with its unit, e.g. `mean wet fraction per part`.
+    pub label: String,
+    /// (row label, scalar name) in the order the rows are shown.
+    pub rows: Vec<(String, String)>,
 }
 
 impl RunSummary {
@@ -179,6 +216,8 @@ impl RunSummary {
             artifacts: Vec::new(),
             scalars: Vec::new(),
             maps: Vec::new(),
+            curves: Vec::new(),
+            scalar_tables: Vec::new(),
         }
     }
 

@@ -2,7 +2,7 @@
 //! runner uses it to skip finished cases and to build its results table, the run report to show the key
 //! numbers.
 
-use crate::run::{MeshMapRecord, RunSummary};
+use crate::run::{CurveRecord, MeshMapRecord, RunSummary, ScalarTableRecord};
 use serde::{Deserialize, Serialize};
 use spatter_core::control::Finished;
 use std::path::{Path, PathBuf};
@@ -35,6 +35,13 @@ pub struct SummaryFile {
     /// inside it.
     #[serde(default)]
     pub maps: Vec<MeshMapRecord>,
+    /// Curves written as CSV columns, with the CSV paths relative to the run folder where they are inside
+    /// it.
+    #[serde(default)]
+    pub curves: Vec<CurveRecord>,
+    /// Named tables of scalars (row label → scalar name).
+    #[serde(default)]
+    pub scalar_tables: Vec<ScalarTableRecord>,
 }
 
 impl SummaryFile {
@@ -67,6 +74,15 @@ impl SummaryFile {
                     ..m.clone()
                 })
                 .collect(),
+            curves: s
+                .curves
+                .iter()
+                .map(|c| CurveRecord {
+                    csv: c.csv.strip_prefix(root).map(Path::to_owned).unwrap_or_else(|_| c.csv.clone()),
+                    ..c.clone()
+                })
+                .collect(),
+            scalar_tables: s.scalar_tables.clone(),
         }
     }
 
@@ -122,6 +138,19 @@ mod tests {
             up: [0.0, 1.0, 0.0],
             title: "panel: impacts".into(),
             colorbar_label: "impacts".into(),
+            scale: Some([0.0, 0.5]),
+        });
+        s.curves.push(CurveRecord {
+            label: "profile".into(),
+            csv: dir.path().join("profile.csv"),
+            x_column: "x_m".into(),
+            y_column: "v_m_s".into(),
+            x_label: "x [m]".into(),
+            y_label: "v [m/s]".into(),
+        });
+        s.scalar_tables.push(ScalarTableRecord {
+            label: "height per part".into(),
+            rows: vec![("a".into(), "z_m".into())],
         });
         let f = SummaryFile::of(&s, "dem", dir.path(), 1.5, 2);
         f.write(dir.path()).unwrap();
@@ -131,6 +160,9 @@ mod tests {
         assert!(back.scalar("a_J").unwrap().is_nan());
         assert_eq!(back.artifacts[0].1, Path::new("map.png"));
         assert_eq!(back.maps[0].vtu, Path::new("panel.vtu"));
+        assert_eq!(back.maps[0].scale, Some([0.0, 0.5]));
+        assert_eq!(back.curves[0].csv, Path::new("profile.csv"));
+        assert_eq!(back.scalar_tables[0].rows[0].1, "z_m");
         assert!(back.completed());
         std::fs::write(dir.path().join(FILE), "{").unwrap();
         assert!(SummaryFile::read(dir.path()).unwrap_err().contains("not a run summary"));

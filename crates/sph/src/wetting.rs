@@ -106,13 +106,21 @@ pub fn wetting_map(sim: &Simulation, k: usize, elapsed: f64) -> WettingMap {
 /// the wall surface, with the area the particle stands for (used for the pictures: sharp whatever the
 /// triangulation). Returns the squares and, per triangle, the wet-time fraction.
 pub fn particle_map(sim: &Simulation, k: usize, elapsed: f64) -> (TriMesh, Vec<f64>) {
+    let t = elapsed.max(f64::MIN_POSITIVE);
+    let wet_time = &sim.boundary.wet_time;
+    particle_squares(sim, k, |i| (wet_time[i] / t).min(1.0))
+}
+
+/// The squares of [`particle_map`] (one per first-layer wall particle of part `k`, where the particles
+/// are now) with `value(i)` of boundary particle `i` on both triangles of its square; e.g. the wet flag
+/// for a map of the wetting at one moment.
+pub fn particle_squares(sim: &Simulation, k: usize, value: impl Fn(usize) -> f64) -> (TriMesh, Vec<f64>) {
     let part = &sim.boundary.parts[k];
     let b = &sim.boundary;
     let dp = sim.params.spacing;
-    let t = elapsed.max(f64::MIN_POSITIVE);
     let offset = part.sampling.surface_offset(dp);
     let mut soup = Vec::new();
-    let mut frac = Vec::new();
+    let mut values = Vec::new();
     for i in part.start..part.end {
         let a = b.area[i];
         if a <= 0.0 {
@@ -126,14 +134,14 @@ pub fn particle_map(sim: &Simulation, k: usize, elapsed: f64) -> (TriMesh, Vec<f
         let (u, v) = (u * (0.5 * side), v * (0.5 * side));
         let (p0, p1, p2, p3) = (c - u - v, c + u - v, c + u + v, c - u + v);
         soup.extend([p0, p1, p2, p0, p2, p3]);
-        let f = (b.wet_time[i] / t).min(1.0);
-        frac.extend([f, f]);
+        let f = value(i);
+        values.extend([f, f]);
     }
     let mesh = TriMesh {
         vertices: soup.clone(),
         triangles: (0..soup.len() / 3).map(|q| [3 * q as u32, 3 * q as u32 + 1, 3 * q as u32 + 2]).collect(),
     };
-    (mesh, frac)
+    (mesh, values)
 }
 
 /// A view direction and up vector that look at the part's main face.

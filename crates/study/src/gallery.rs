@@ -4,7 +4,8 @@
 //! cell array, the view). Each case picks its own colour scale, so two cases' pictures cannot be compared
 //! colour for colour; the study therefore reads the recorded arrays of every case, takes one scale over all
 //! of them (from 0, or the lowest value if negative, to the highest finite value) and draws every case's
-//! map again on it, into `gallery/<map label>/case_NNNNN.png`.
+//! map again on it, into `gallery/<map label>/case_NNNNN.png`. When every case drew the map on the same
+//! fixed scale (a run's `wetting_cap`), that scale is kept, so the study's pictures read like the runs'.
 
 use crate::plan::{case_dir_name, Plan};
 use spatter_core::mesh::TriMesh;
@@ -21,6 +22,8 @@ pub struct Gallery {
     pub label: String,
     /// The common colour scale (low, high) in the map's unit.
     pub scale: (f64, f64),
+    /// True when the scale is the one every case fixed (e.g. a wetting cap), not one over their values.
+    pub fixed: bool,
     /// The colour-bar label (name and unit).
     pub colorbar_label: String,
     /// (caption, picture) per case, in case order.
@@ -61,7 +64,15 @@ pub fn redraw(plan: &Plan, out: &Path, max_cases: usize) -> Vec<Gallery> {
     let mut galleries = Vec::new();
     for label in labels {
         let of_label: Vec<&CaseMap> = maps.iter().filter(|m| m.record.label == label).collect();
-        let scale = common_scale(of_label.iter().map(|m| m.values.as_slice()));
+        // A scale every case fixed alike (a wetting cap) is kept; otherwise one over every case's values.
+        let fixed = of_label
+            .first()
+            .and_then(|m| m.record.scale)
+            .filter(|s| s[1] > s[0] && of_label.iter().all(|m| m.record.scale == Some(*s)));
+        let scale = match fixed {
+            Some([lo, hi]) => (lo, hi),
+            None => common_scale(of_label.iter().map(|m| m.values.as_slice())),
+        };
         let folder = out.join("gallery").join(file_safe(&label));
         if let Err(e) = std::fs::create_dir_all(&folder) {
             tracing::warn!("gallery: cannot create {}: {e}", folder.display());
@@ -73,13 +84,14 @@ pub fn redraw(plan: &Plan, out: &Path, max_cases: usize) -> Vec<Gallery> {
             let r = &m.record;
             let title = format!("case {}: {}", m.case, r.title);
             let view = (Vec3::from_array(r.view_dir), Vec3::from_array(r.up));
+            let caption = plan.cases.iter().find(|c| c.index == m.case).map(|c| plan.caption(c));
             match mesh_map_png_on_scale(&png, &m.mesh, &m.values, view, (&title, &r.colorbar_label), scale) {
-                Ok(()) => pictures.push((format!("case {}", m.case), png)),
+                Ok(()) => pictures.push((caption.unwrap_or_else(|| format!("case {}", m.case)), png)),
                 Err(e) => tracing::warn!("gallery: case {}: {e}", m.case),
             }
         }
         let colorbar_label = of_label.first().map(|m| m.record.colorbar_label.clone()).unwrap_or_default();
-        galleries.push(Gallery { label, scale, colorbar_label, pictures });
+        galleries.push(Gallery { label, scale, fixed: fixed.is_some(), colorbar_label, pictures });
     }
     galleries
 }

@@ -13,8 +13,10 @@
 //! * [`table`] — the results table, built from the case folders (so shards merge by collecting);
 //! * [`sensitivity`] — Saltelli design, Sobol first-order and total indices, Latin hypercube;
 //! * [`outputs`] — the study's plots, Sobol tables and report.
-//! * [`gallery`] — the same map of every case redrawn on one colour scale.
+//! * [`gallery`] — the same map of every case redrawn on one colour scale;
+//! * [`curves`] — the same curve of every case overlaid, tables of scalars with a column per case.
 
+pub mod curves;
 pub mod gallery;
 pub mod keys;
 pub mod outputs;

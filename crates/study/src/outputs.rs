@@ -1,6 +1,8 @@
 //! What a finished study writes: the results and cost tables, a plot of every analysed output against
-//! every varied key, Sobol indices (table and chart) for a Sobol design, and `report.html`.
+//! every varied key, Sobol indices (table and chart) for a Sobol design, the maps, curves and tables of
+//! scalars every case recorded side by side, and `report.html`.
 
+use crate::curves::{case_tables, overlay, CaseTable, Overlay};
 use crate::gallery::{file_safe, redraw, Gallery};
 use crate::plan::{case_dir_name, Plan};
 use crate::sensitivity::{indices, Indices};
@@ -76,8 +78,17 @@ pub fn write_all(
     for g in &galleries {
         written.push((format!("{} of every case on one colour scale", g.label), out.join("gallery")));
     }
+    let overlays = overlay(plan, out, GALLERY_CASES);
+    for o in &overlays {
+        written.push((format!("{} of every case", o.label), o.picture.clone()));
+    }
+    let tables = case_tables(plan, table, out);
+    for t in &tables {
+        written.push((format!("{} per case", t.label), t.csv.clone()));
+    }
     let report = out.join("report.html");
-    let figures = Figures { plots: &plots, sobol: &sobol, galleries: &galleries };
+    let figures =
+        Figures { plots: &plots, sobol: &sobol, galleries: &galleries, overlays: &overlays, tables: &tables };
     study_report(study, plan, table, &outputs, &figures, out)
         .write(&report)
         .map_err(|source| StudyError::Io { path: report.clone(), source })?;
@@ -198,6 +209,10 @@ struct Figures<'a> {
     sobol: &'a [SobolResult],
     /// Maps of every case redrawn on one colour scale.
     galleries: &'a [Gallery],
+    /// Curves of every case overlaid.
+    overlays: &'a [Overlay],
+    /// Tables of scalars with a column per case.
+    tables: &'a [CaseTable],
 }
 
 fn study_report(
@@ -208,7 +223,7 @@ fn study_report(
     figures: &Figures,
     out: &Path,
 ) -> Report {
-    let Figures { plots, sobol, galleries } = *figures;
+    let Figures { plots, sobol, galleries, overlays, tables } = *figures;
     let title = study.spec.title.clone().unwrap_or_else(|| format!("Study {}", study.source.path.display()));
     let mut r = Report::new(&title);
     r.text(&format!(
@@ -265,6 +280,47 @@ fn study_report(
             tracing::warn!("report: {e}");
         }
     }
+    for g in galleries {
+        r.heading(&format!("{}: every case on one colour scale", g.label));
+        let whose = if g.fixed {
+            "the scale every case fixed (values above it show in the top colour)"
+        } else {
+            "the range of every case's values; each case's own pictures, on its own scale, are in its folder"
+        };
+        r.text(&format!(
+            "Colour scale {} to {} ({}) for every case: {whose}.",
+            spatter_io::plot::tick_label(g.scale.0),
+            spatter_io::plot::tick_label(g.scale.1),
+            g.colorbar_label
+        ));
+        let refs: Vec<(String, &Path)> = g.pictures.iter().map(|(l, p)| (l.clone(), p.as_path())).collect();
+        if let Err(e) = r.gallery(&refs) {
+            tracing::warn!("report: {e}");
+        }
+    }
+    for o in overlays {
+        r.heading(&format!("{}: every case", o.label));
+        if let Err(e) = r.picture(&format!("{} of {} cases", o.label, o.cases.len()), &o.picture) {
+            tracing::warn!("report: {e}");
+        }
+    }
+    for t in tables {
+        r.heading(&format!("{}: every case", t.label));
+        let mut header = vec![String::new()];
+        header.extend(t.cases.iter().cloned());
+        let rows = t
+            .rows
+            .iter()
+            .zip(&t.values)
+            .map(|(row, v)| {
+                let mut cells = vec![row.clone()];
+                cells.extend(v.iter().map(|x| if x.is_finite() { short_number(*x) } else { String::new() }));
+                cells
+            })
+            .collect();
+        r.table(header, rows);
+    }
+    cost_table(&mut r, plan, table);
     if !plots.is_empty() {
         r.heading("Outputs against the varied keys");
         for (label, p) in plots {
@@ -295,19 +351,6 @@ fn study_report(
     if table.rows.len() > REPORT_ROWS {
         r.text(&format!("First {REPORT_ROWS} of {} cases; all are in results.csv.", table.rows.len()));
     }
-    for g in galleries {
-        r.heading(&format!("{}: every case on one colour scale", g.label));
-        r.text(&format!(
-            "Colour scale {} to {} ({}) for every case; each case's own pictures, on its own scale, are in its folder.",
-            spatter_io::plot::tick_label(g.scale.0),
-            spatter_io::plot::tick_label(g.scale.1),
-            g.colorbar_label
-        ));
-        let refs: Vec<(String, &Path)> = g.pictures.iter().map(|(l, p)| (l.clone(), p.as_path())).collect();
-        if let Err(e) = r.gallery(&refs) {
-            tracing::warn!("report: {e}");
-        }
-    }
     let gallery: Vec<(String, PathBuf)> = plan
         .cases
         .iter()
@@ -318,7 +361,7 @@ fn study_report(
             let s = SummaryFile::read(&dir).ok().flatten()?;
             let (_, p) = s.artifacts.iter().find(|(_, p)| p.extension().is_some_and(|e| e == "png"))?;
             let p = if p.is_absolute() { p.clone() } else { dir.join(p) };
-            p.is_file().then(|| (format!("case {}", c.index), p))
+            p.is_file().then(|| (plan.caption(c), p))
         })
         .collect();
     if !gallery.is_empty() {
@@ -333,6 +376,67 @@ fn study_report(
     r
 }
 
+/// The cost of every case (particles, steps, wall time, threads, core-hours) and the total.
+fn cost_table(r: &mut Report, plan: &Plan, table: &Table) {
+    let costs = table.costs();
+    r.heading("Cost per case");
+    let cell = |v: Option<f64>| v.map(|x| format!("{x:.0}")).unwrap_or_default();
+    let mut rows: Vec<Vec<String>> = costs
+        .iter()
+        .map(|c| {
+            let caption = plan.cases.iter().find(|k| k.index == c.case).map(|k| plan.caption(k));
+            vec![
+                caption.unwrap_or_else(|| format!("case {}", c.case)),
+                cell(c.particles),
+                cell(c.wall_particles),
+                cell(c.steps),
+                format!("{:.1}", c.wall_time_s),
+                c.threads.to_string(),
+                format!("{:.4}", c.core_hours()),
+                c.particle_steps_per_s().map(|x| format!("{x:.3e}")).unwrap_or_default(),
+            ]
+        })
+        .collect();
+    rows.push(vec![
+        "all cases".into(),
+        String::new(),
+        String::new(),
+        String::new(),
+        format!("{:.1}", costs.iter().map(|c| c.wall_time_s).sum::<f64>()),
+        String::new(),
+        format!("{:.4}", costs.iter().map(|c| c.core_hours()).sum::<f64>()),
+        String::new(),
+    ]);
+    r.table(
+        [
+            "case",
+            "particles",
+            "wall particles",
+            "steps",
+            "wall time [s]",
+            "threads",
+            "core-hours",
+            "particle-steps/s",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows,
+    );
+}
+
+/// A number with four significant digits, in plain notation between 10⁻³ and 10⁴ (and for 0).
+fn short_number(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 {
+        "0".to_owned()
+    } else if (1e-3..1e4).contains(&a) {
+        let digits = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Threads the first case ran with (for the core-hours estimate).
 fn threads_used(plan: &Plan, out: &Path) -> usize {
     plan.cases
@@ -340,4 +444,19 @@ fn threads_used(plan: &Plan, out: &Path) -> usize {
         .and_then(|c| SummaryFile::read(&out.join("cases").join(case_dir_name(c.index))).ok().flatten())
         .map(|s| s.threads.max(1))
         .unwrap_or(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short_number;
+
+    #[test]
+    fn short_numbers_keep_four_significant_digits() {
+        assert_eq!(short_number(0.0), "0");
+        assert_eq!(short_number(0.091234), "0.09123");
+        assert_eq!(short_number(1.0), "1.000");
+        assert_eq!(short_number(1234.56), "1235");
+        assert_eq!(short_number(2.5e-5), "2.500e-5");
+        assert_eq!(short_number(-3.0e6), "-3.000e6");
+    }
 }

@@ -39,6 +39,18 @@ pub fn case_dir_name(index: usize) -> String {
 }
 
 impl Plan {
+    /// A case named with its values, for captions and legends: `case 3: adhesion = 0.1, enabled = true`
+    /// (each key by its last part).
+    pub fn caption(&self, case: &Case) -> String {
+        let values: Vec<String> = self
+            .keys
+            .iter()
+            .zip(&case.values)
+            .map(|(k, v)| format!("{} = {}", k.rsplit('.').next().unwrap_or(k), table_text(v)))
+            .collect();
+        format!("case {}: {}", case.index, values.join(", "))
+    }
+
     /// Reads the base scenario, checks every varied key against it and builds every case. `case_root` is
     /// where case folders will be (case scenarios are validated as if they were there).
     pub fn new(study: &StudyFile, case_root: &Path) -> Result<Plan, Vec<ScenarioError>> {

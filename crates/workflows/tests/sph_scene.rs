@@ -734,3 +734,42 @@ fn a_checkpoint_resumes_on_another_rank_count_with_repartition() {
         assert!(!dir.join("checkpoint.bin").exists() && !dir.join("checkpoint").exists(), "{what}");
     }
 }
+
+/// Instantaneous wetting maps (`output.wetting_map_times_s`): at t = 0 the tank's wet squares are the
+/// water column's wetted perimeter, floor a = 0.1 m plus the left wall 2a = 0.2 m (per metre of depth,
+/// within 2 dp for the corners), and at every map time the wet squares add up to the wet area the series
+/// reports at that moment (the same wet flags, exactly).
+#[test]
+fn instantaneous_maps_show_the_wetting_of_their_moment() {
+    let text = SMALL
+        .replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwetting_map_times_s = [0.0, 0.05]");
+    let cfg = config(&text);
+    let tmp = tempfile::tempdir().unwrap();
+    let summary = run_to_end(&cfg, tmp.path());
+    assert!(summary.finished == Finished::Completed);
+    let (cols, rows) = spatter_io::csv::read_series(&tmp.path().join("series.csv")).unwrap();
+    let wet = column(&cols, &rows, "tank_wet_area_m2");
+    let dp = 0.01;
+    let mut areas = Vec::new();
+    for n in 0..2 {
+        let dir = tmp.path().join(format!("wetting/instant_{n:02}"));
+        assert!(dir.join("tank.png").is_file(), "map {n}: picture missing");
+        let vtu = spatter_io::vtk::read(&dir.join("tank.vtu")).unwrap();
+        let now = &vtu.cell_array("wet_now").unwrap().values;
+        assert!(now.iter().all(|v| *v == 0.0 || *v == 1.0), "wet or dry only");
+        // Two triangles per wall particle, each standing for dp of wall per metre of depth in 2D.
+        areas.push(now.iter().sum::<f64>() / 2.0 * dp);
+    }
+    assert!((areas[0] - 0.3).abs() <= 2.0 * dp, "wetted perimeter at rest: {} m", areas[0]);
+    assert!((areas[0] - wet[0]).abs() < 1e-12, "map 0 {} vs series {}", areas[0], wet[0]);
+    let last = *wet.last().unwrap();
+    assert!((areas[1] - last).abs() < 1e-12, "map 1 {} vs series {last}", areas[1]);
+    assert!(areas[1] != areas[0], "the surge has moved the wet line");
+    let e = toml::from_str::<SphConfig>(
+        &SMALL.replace("sample_interval_s = 0.002", "wetting_map_times_s = [0.02, 0.01]"),
+    )
+    .unwrap();
+    let errs = Checker::run(&e, None).unwrap_err();
+    assert_eq!(errs[0].key, "output.wetting_map_times_s[1]", "{errs:?}");
+    assert!(errs[0].message.contains("must increase"), "{errs:?}");
+}

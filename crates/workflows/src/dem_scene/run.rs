@@ -765,6 +765,7 @@ fn write_wear_maps<L: ContactLaw>(
             up: up.to_array(),
             title,
             colorbar_label: colorbar.into(),
+            scale: None,
         };
         out.push((name.clone(), png, record));
     }

@@ -373,6 +373,7 @@ fn write_bodies(
             up: spec.view_up.to_array(),
             title,
             colorbar_label: label.to_owned(),
+            scale: None,
         });
         let mass: f64 = d.mass.iter().sum();
         let area: f64 = areas.iter().sum();

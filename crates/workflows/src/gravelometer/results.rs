@@ -352,6 +352,7 @@ pub fn report(
         up: plan.frame.up.to_array(),
         title: format!("{}: eroded mass on the panel (seen from the pipe)", cfg.input.standard.label()),
         colorbar_label: "eroded mass per area [kg/m²]".into(),
+        scale: None,
     });
     summary.artifacts.push(("damage on the panel (ParaView)".into(), vtu));
 

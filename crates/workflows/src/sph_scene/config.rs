@@ -279,6 +279,10 @@ pub struct OutputConfig {
     /// largest value of each map. A fixed cap puts the maps of several runs on one scale.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wetting_cap: Option<f64>,
+    /// Times at which every part's wetting at that moment is written (`wetting/instant_NN/<part>.vtu` and
+    /// `.png`, wet or dry on the scale 0–1) \[s\], increasing, within the run. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub wetting_map_times_s: Vec<f64>,
 }
 
 impl OutputConfig {
@@ -572,6 +576,18 @@ impl Validate for SphConfig {
             }
             if let Some(v) = o.wetting_cap {
                 c.in_range("wetting_cap", v, 0.0, false, 1.0, true);
+            }
+            for (i, t) in o.wetting_map_times_s.iter().enumerate() {
+                let before = i.checked_sub(1).map(|j| o.wetting_map_times_s[j]);
+                if !(t.is_finite() && *t >= 0.0 && *t <= o.end_time_s && before.is_none_or(|b| *t > b)) {
+                    c.fail(
+                        &format!("wetting_map_times_s[{i}]"),
+                        format!(
+                            "{t} s: the times must increase and lie within the run, 0 to end_time_s = {} s",
+                            o.end_time_s
+                        ),
+                    );
+                }
             }
             if let Some(v) = o.sample_interval_s {
                 c.positive("sample_interval_s", v);

@@ -21,12 +21,12 @@ use spatter_core::Vec3;
 use spatter_io::csv::{write_table, CsvSeries};
 use spatter_io::pvd::PvdSeries;
 use spatter_io::rank_checkpoint::Resumed;
-use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
+use spatter_io::run::{CurveRecord, MeshMapRecord, RunContext, RunSummary};
 use spatter_io::vtu::Vtu;
 use spatter_sph::error::SphError;
 use spatter_sph::sim::Simulation;
-use spatter_sph::wetting::{default_view, particle_map, wet_area, wetting_map};
-use std::path::Path;
+use spatter_sph::wetting::{default_view, particle_map, particle_squares, wet_area, wetting_map};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Everything a resumed run needs besides the configuration.
@@ -46,6 +46,8 @@ struct SceneState {
     flux_down: Vec<f64>,
     /// Wall-clock seconds of earlier sessions.
     wall_seconds: f64,
+    /// Instantaneous wetting maps written so far (`output.wetting_map_times_s`).
+    maps_written: usize,
 }
 
 /// One rank's part of a checkpoint written on several ranks: its state (its own fluid; wet times, height
@@ -355,6 +357,7 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
             flux_up: vec![0.0; nb + 1],
             flux_down: vec![0.0; nb + 1],
             wall_seconds: 0.0,
+            maps_written: 0,
         };
         if cfg.output.wall_particles {
             let wetting = st.sim.wetting_with(comm);
@@ -424,6 +427,11 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
                 st.next_vtu += vtu_dt;
             }
         }
+        let map_times = &cfg.output.wetting_map_times_s;
+        while st.maps_written < map_times.len() && st.sim.time >= map_times[st.maps_written] - 1e-12 * end {
+            write_instant_maps(cfg, dir, &st.sim, st.maps_written, comm)?;
+            st.maps_written += 1;
+        }
         if st.sim.time >= end - 1e-12 * end {
             break;
         }
@@ -469,6 +477,54 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
 }
 
 /// Height bins and plane fluxes over the averaging window.
+/// Every part's wetting at this moment (map `n` of `output.wetting_map_times_s`, written at the first step
+/// at or after its time): `wetting/instant_NN/<part>.vtu` (cell array `wet_now`, 1 wet and 0 dry, on one
+/// square per wall particle where the part is now) and `.png` on the scale 0–1, from the view of the
+/// part's time-averaged map. A collective on several ranks (the wet flags are gathered); rank 0 writes.
+fn write_instant_maps(
+    cfg: &SphConfig,
+    dir: &spatter_io::run::RunDir,
+    sim: &Simulation,
+    n: usize,
+    comm: &dyn Comm,
+) -> Result<(), SphError> {
+    let (wet, _) = sim.wetting_with(comm);
+    if !comm.is_root() {
+        return Ok(());
+    }
+    for k in 0..sim.boundary.parts.len() {
+        let name = &sim.boundary.parts[k].name;
+        let wcfg = cfg.walls.iter().find(|w| w.name == *name);
+        if !wcfg.map(|w| w.wetting_map).unwrap_or(true) {
+            continue;
+        }
+        let (squares, now) = particle_squares(sim, k, |i| if wet[i] { 1.0 } else { 0.0 });
+        if squares.triangles.is_empty() {
+            continue;
+        }
+        let vtu = dir.path(&format!("wetting/instant_{n:02}/{name}.vtu"));
+        Vtu::triangles(&squares.vertices, &squares.triangles)
+            .cell_scalar("wet_now", &now)
+            .write(&vtu)
+            .map_err(fatal(comm, &vtu))?;
+        let (dv, du) = default_view(sim, k);
+        let view = wcfg.and_then(|w| w.view_dir).unwrap_or(dv);
+        let up = wcfg.and_then(|w| w.up).unwrap_or(du);
+        let png = vtu.with_extension("png");
+        let title = format!("{name}: wet at t = {:.4} s", sim.time);
+        spatter_io::plot::mesh_map_png_on_scale(
+            &png,
+            &squares,
+            &now,
+            (view, up),
+            (&title, "wet (1) or dry (0)"),
+            (0.0, 1.0),
+        )
+        .map_err(fatal(comm, &png))?;
+    }
+    Ok(())
+}
+
 fn accumulate_height(cfg: &SphConfig, st: &mut SceneState) {
     let Some(h) = &cfg.sensors.height else { return };
     let sim = &mut st.sim;
@@ -582,6 +638,7 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> R
             up: up.to_array(),
             title,
             colorbar_label: colorbar.into(),
+            scale: cfg.output.wetting_cap.map(|cap| [0.0, cap]),
         });
     }
     let wet_csv = dir.path("wetting.csv");
@@ -644,6 +701,14 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> R
             &rows,
         )
         .map_err(io_at(&p))?;
+        summary.curves.push(CurveRecord {
+            label: "splash height distribution".into(),
+            csv: p.clone(),
+            x_column: "height_over_depth".into(),
+            y_column: "mean_volume_m3".into(),
+            x_label: "height / depth".into(),
+            y_label: "mean volume [m³]".into(),
+        });
         summary.artifacts.push(("splash heights".into(), p));
         // Volume-weighted mean height of the resident water and the highest bin holding any.
         let total: f64 = vol_pts.iter().map(|(_, v)| v).sum();
@@ -697,6 +762,7 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> R
         ("t_end_s", sim.time),
         ("steps", sim.steps as f64),
         ("fluid_particles", particles as f64),
+        ("wall_particles", sim.boundary.len() as f64),
         ("removed_outside_domain", sim.removed.outside_domain as f64),
         ("removed_density_window", sim.removed.density_window as f64),
     ] {

@@ -1,6 +1,7 @@
 //! The scenario file of kind `wading`: every key, its unit and default (documented in `docs/wading.md`).
 
 use super::channel::ChannelSpec;
+use super::patches::SensorBox;
 use super::vehicle::{PartFile, WheelSpec};
 use crate::sph_scene::config::{DragConfig, FluidConfig};
 use serde::{Deserialize, Serialize};
@@ -44,6 +45,10 @@ pub struct WadingConfig {
     /// Sensor patches: names of vehicle parts whose wet fraction is followed over time.
     #[serde(default)]
     pub sensors: Vec<String>,
+    /// Sensor patches cut out of vehicle parts by boxes (`[[sensor_boxes]]`); each is followed over time
+    /// like the parts in `sensors`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensor_boxes: Vec<SensorBox>,
     #[serde(default)]
     pub output: WadingOutput,
 }
@@ -96,6 +101,10 @@ pub struct WadingOutput {
     /// Highest splash height recorded, in water depths above the pool floor. Default 12.
     #[serde(default = "d_top")]
     pub splash_top_over_depth: f64,
+    /// Front-axle x positions at which every part's wetting at that moment is written
+    /// (`wetting/instant_NN/`) \[m\], increasing, between the start and the end of the run. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub map_positions_m: Vec<f64>,
 }
 
 impl Default for WadingOutput {
@@ -107,6 +116,7 @@ impl Default for WadingOutput {
             wetting_cap: d_cap(),
             splash_bin_over_depth: d_bin(),
             splash_top_over_depth: d_top(),
+            map_positions_m: Vec::new(),
         }
     }
 }
@@ -169,7 +179,19 @@ impl Validate for WadingConfig {
             c.in_range("wetting_cap", o.wetting_cap, 0.0, false, 1.0, true);
             c.positive("splash_bin_over_depth", o.splash_bin_over_depth);
             c.positive("splash_top_over_depth", o.splash_top_over_depth);
+            for (i, x) in o.map_positions_m.iter().enumerate() {
+                let before = i.checked_sub(1).map(|j| o.map_positions_m[j]);
+                if !(x.is_finite() && before.is_none_or(|b| *x > b)) {
+                    c.fail(
+                        &format!("map_positions_m[{i}]"),
+                        format!("{x} m: the front-axle positions must be finite and increase"),
+                    );
+                }
+            }
         });
+        for (i, b) in self.sensor_boxes.iter().enumerate() {
+            c.element("sensor_boxes", i, |c| b.validate(c));
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //!
 //! The channel is generated from a few numbers with the still water's extent, wheels are placed on its
 //! road and the body's pitch follows the axle heights ([`channel`]); the vehicle's parts are read from
-//! multi-solid STL files ([`parts`]); wheels are found by part name and checked against their declared
+//! multi-solid STL files ([`parts`]), sensor patches cut out of them by boxes ([`patches`]); wheels are found by part name and checked against their declared
 //! radius, the vehicle is checked against the channel's width and placed on the road ([`vehicle`]); the
 //! speed over time ([`timeline`]); the channel surfaces and the placed parts are written as STL
 //! ([`geometry`]); [`run`] turns all of it into an `sph` scene with motion tables (body pitch and travel,
@@ -13,6 +13,7 @@ pub mod channel;
 pub mod config;
 pub mod geometry;
 pub mod parts;
+pub mod patches;
 pub mod run;
 pub mod timeline;
 pub mod vehicle;

@@ -14,7 +14,7 @@ use crate::sph_scene::config::{
 };
 use spatter_core::control::Finished;
 use spatter_core::Vec3;
-use spatter_io::run::{RunContext, RunSummary};
+use spatter_io::run::{CurveRecord, RunContext, RunSummary, ScalarTableRecord};
 use spatter_sph::boundary::Slip;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -55,6 +55,10 @@ pub struct Plan {
     pub t_end: f64,
     /// Largest front-wheel radius \[m\].
     pub r_front: f64,
+    /// Sensor patches followed over time: the parts named in `sensors`, then the box patches.
+    pub sensors: Vec<String>,
+    /// Times of the instantaneous wetting maps (front axle at `output.map_positions_m`) \[s\].
+    pub map_times: Vec<f64>,
 }
 
 /// Reads the parts, checks the wheels and the width, and fixes the start and the end of the run.
@@ -74,6 +78,12 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
             groups.push(pf.group.clone().unwrap_or_else(|| p.name.clone()));
             parts.push(p);
         }
+    }
+    let wheel_names: Vec<&str> = cfg.vehicle.wheels.iter().map(|w| w.part.as_str()).collect();
+    for (i, b) in cfg.sensor_boxes.iter().enumerate() {
+        let k = super::patches::cut(&mut parts, b, &wheel_names)
+            .map_err(|e| input(&format!("sensor_boxes[{i}].{}", e.key), e.message))?;
+        groups.push(groups[k].clone());
     }
     let errs = check_wheels(&parts, &cfg.vehicle.wheels);
     if let Some(e) = errs.into_iter().next() {
@@ -127,7 +137,25 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
             )
         })?,
     };
-    Ok(Plan { parts, groups, speed, x_front0, t_enter, t_end, r_front })
+    let mut map_times = Vec::new();
+    for (i, x) in cfg.output.map_positions_m.iter().enumerate() {
+        let x_end = x_front0 + speed.distance(t_end);
+        // The end itself is a valid position (its time may come out a rounding error beyond the end).
+        match speed.time_to(x - x_front0).filter(|t| *x >= x_front0 && *t <= t_end * (1.0 + 1e-9)) {
+            Some(t) => map_times.push(t.min(t_end)),
+            None => {
+                return Err(input(
+                    &format!("output.map_positions_m[{i}]"),
+                    format!(
+                    "{x} m: the front axle travels from x = {x_front0:.3} m to {x_end:.3} m during the run"
+                ),
+                ))
+            }
+        }
+    }
+    let mut sensors = cfg.sensors.clone();
+    sensors.extend(cfg.sensor_boxes.iter().map(|b| b.name.clone()));
+    Ok(Plan { parts, groups, speed, x_front0, t_enter, t_end, r_front, sensors, map_times })
 }
 
 fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
@@ -280,6 +308,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
             sample_interval_s: Some(cfg.output.sample_interval_s.unwrap_or(t_end / 400.0)),
             wall_particles: false,
             wetting_cap: Some(cfg.output.wetting_cap),
+            wetting_map_times_s: plan.map_times.clone(),
         },
         sensors: SensorConfig {
             wet_distance_m: None,
@@ -397,13 +426,13 @@ fn report(
     .map_err(io_err(&gpath))?;
     summary.artifacts.push(("wetting per group".into(), gpath));
     // Sensor series: wet fraction over time from series.csv.
-    if !cfg.sensors.is_empty() {
+    if !plan.sensors.is_empty() {
         let spath = dir.path("series.csv");
         let text = std::fs::read_to_string(&spath).map_err(io_err(&spath))?;
         let mut lines = text.lines();
         let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
         let mut cols = Vec::new();
-        for (k, s) in cfg.sensors.iter().enumerate() {
+        for (k, s) in plan.sensors.iter().enumerate() {
             let col = header.iter().position(|h| *h == format!("{s}_wet_area_m2"));
             let a = area.iter().find(|(n, _, _)| n == s).map(|e| e.1);
             if let (Some(c), Some(a)) = (col, a) {
@@ -433,6 +462,16 @@ fn report(
         let head: Vec<&str> = head.iter().map(String::as_str).collect();
         let p = dir.path("sensors.csv");
         spatter_io::csv::write_table(&p, &head, &rows).map_err(io_err(&p))?;
+        for (name, _, _) in &cols {
+            summary.curves.push(CurveRecord {
+                label: format!("{name} wet fraction over time"),
+                csv: p.clone(),
+                x_column: "t_s".into(),
+                y_column: format!("{name}_wet_fraction"),
+                x_label: "time [s]".into(),
+                y_label: format!("wet fraction of {name}"),
+            });
+        }
         summary.artifacts.push(("sensor wet fractions".into(), p));
         let mut chart =
             spatter_io::plot::Chart::new("Sensor patches", "time [s]", "wet fraction of the patch");
@@ -442,6 +481,29 @@ fn report(
         let png = dir.path("sensors.png");
         chart.save_png(&png).map_err(io_err(&png))?;
         summary.artifacts.push(("sensor plot".into(), png));
+    }
+    // Which instantaneous map is which vehicle position.
+    if !plan.map_times.is_empty() {
+        let rows: Vec<Vec<String>> = plan
+            .map_times
+            .iter()
+            .zip(&cfg.output.map_positions_m)
+            .enumerate()
+            .map(|(n, (t, x))| {
+                vec![format!("instant_{n:02}"), spatter_io::fmt_f64(*t), spatter_io::fmt_f64(*x)]
+            })
+            .collect();
+        let p = dir.path("wetting/instants.csv");
+        spatter_io::csv::write_table(&p, &["folder", "t_s", "front_axle_x_m"], &rows).map_err(io_err(&p))?;
+        summary.artifacts.push(("instantaneous wetting maps (folders, times, positions)".into(), p));
+        for n in 0..plan.map_times.len() {
+            for part in &plan.parts {
+                let png = dir.path(&format!("wetting/instant_{n:02}/{}.png", part.name));
+                if png.is_file() {
+                    summary.artifacts.push((format!("{} wet at position {n}", part.name), png));
+                }
+            }
+        }
     }
     // The study's scalars under the wading names.
     let get = |n: &str| summary.scalars.iter().find(|(k, _)| k == n).map(|e| e.1);
@@ -456,6 +518,26 @@ fn report(
     if vehicle.0 > 0.0 {
         summary.scalar("vehicle_mean_wet_fraction", vehicle.1 / vehicle.0);
     }
+    // The wet fractions as tables a study shows side by side, one column per case.
+    let reported = |n: &str| summary.scalars.iter().any(|(k, _)| k == n);
+    let part_rows: Vec<(String, String)> = area
+        .iter()
+        .map(|(n, _, _)| (n.clone(), format!("{n}_mean_wet_fraction")))
+        .filter(|(_, k)| reported(k))
+        .collect();
+    let mut group_rows: Vec<(String, String)> =
+        groups.iter().map(|(g, _, _)| (g.clone(), format!("group_{g}_mean_wet_fraction"))).collect();
+    if reported("vehicle_mean_wet_fraction") {
+        group_rows.push(("whole vehicle".into(), "vehicle_mean_wet_fraction".into()));
+    }
+    summary.scalar_tables.push(ScalarTableRecord {
+        label: "mean wet fraction per part (area fraction, averaged over the run)".into(),
+        rows: part_rows,
+    });
+    summary.scalar_tables.push(ScalarTableRecord {
+        label: "mean wet fraction per report group (area-weighted)".into(),
+        rows: group_rows,
+    });
     summary.headline.insert(
         0,
         format!(
@@ -473,6 +555,7 @@ fn report(
 mod tests {
     use super::*;
     use crate::wading::config::{MotionSpec, WadingOutput};
+    use crate::wading::patches::SensorBox;
     use crate::wading::vehicle::PartFile;
     use spatter_core::mesh::TriMesh;
     use spatter_core::motion::{Motion, MotionTable};
@@ -574,6 +657,51 @@ mod tests {
         let h = scene.sensors.height.as_ref().unwrap();
         assert_eq!((h.base_z_m, h.reference_depth_m), (-0.5, Some(0.3)));
         assert!((h.bin_m - 0.075).abs() < 1e-12 && h.bins == 48);
+    }
+
+    /// A box cuts the roof's triangles whose centroid it holds into a sensor part of the roof's group
+    /// (one 0.5 m column of a 2 m × 1 m roof of 0.5 m squares: 0.5 m²), followed like a named sensor;
+    /// map positions become the times the front axle reaches them (x = x₀ + v t at 2 m/s).
+    #[test]
+    fn box_patches_become_sensor_parts_and_map_positions_become_times() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = config(dir.path());
+        let roof = dir.path().join("roof.stl");
+        let mut mesh = TriMesh::rectangle(2.0, 1.0, 3.0, 4, 2);
+        mesh.map_vertices(|v| v + Vec3::new(0.5, -0.5, 0.0));
+        write_stl(&roof, "roof", &mesh).unwrap();
+        cfg.vehicle.parts.push(PartFile { file: roof, scale: 1.0, group: Some("body".into()) });
+        cfg.sensor_boxes = vec![SensorBox {
+            name: "antenna".into(),
+            part: "roof".into(),
+            min_m: Vec3::new(0.4, -0.6, 2.9),
+            max_m: Vec3::new(1.0, 0.6, 3.1),
+        }];
+        cfg.output.map_positions_m = vec![5.0, 6.0];
+        let plan = plan(&cfg).unwrap();
+        assert_eq!(plan.sensors, vec!["fl".to_owned(), "antenna".to_owned()]);
+        let k = plan.parts.iter().position(|p| p.name == "antenna").unwrap();
+        assert_eq!(plan.groups[k], "body");
+        assert!((plan.parts[k].mesh.total_area() - 0.5).abs() < 1e-12);
+        let roof = plan.parts.iter().find(|p| p.name == "roof").unwrap();
+        assert!((roof.mesh.total_area() - 1.5).abs() < 1e-12);
+        for (t, x) in plan.map_times.iter().zip([5.0, 6.0]) {
+            assert!((t - (x - plan.x_front0) / 2.0).abs() < 1e-9, "{t} for x = {x}");
+        }
+        let scene = scene(&cfg, &plan, &dir.path().join("geometry")).unwrap();
+        assert_eq!(scene.output.wetting_map_times_s, plan.map_times);
+        assert!(scene.walls.iter().any(|w| w.name == "antenna" && w.motion.as_deref() == Some("body")));
+        cfg.output.map_positions_m = vec![100.0];
+        let e = plan_err(&cfg);
+        assert!(e.starts_with("output.map_positions_m[0]: 100 m: the front axle travels from x ="), "{e}");
+        cfg.output.map_positions_m.clear();
+        cfg.sensor_boxes[0].part = "fl".into();
+        let e = plan_err(&cfg);
+        assert!(e.starts_with("sensor_boxes[0].part: part = \"fl\" is a wheel"), "{e}");
+    }
+
+    fn plan_err(cfg: &WadingConfig) -> String {
+        plan(cfg).err().unwrap().to_string()
     }
 
     #[test]
