@@ -26,7 +26,7 @@ use spatter_io::vtu::Vtu;
 use spatter_sph::error::SphError;
 use spatter_sph::sim::Simulation;
 use spatter_sph::wetting::{default_view, particle_map, particle_squares, wet_area, wetting_map};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// Everything a resumed run needs besides the configuration.
