@@ -81,12 +81,19 @@ pub enum SourceError {
 pub struct PointForce {
     adds: [(u8, usize, f64); 24],
     len: usize,
+    boundary: [f64; 3],
 }
 
 impl PointForce {
     /// The (component, node, acceleration) shares.
     pub fn nodes(&self) -> &[(u8, usize, f64)] {
         &self.adds[..self.len]
+    }
+
+    /// The part of the force \[N\] that boundary faces carry (see [`Flow::point_force_shares`]): the fluid
+    /// receives the force less this.
+    pub fn on_boundaries(&self) -> [f64; 3] {
+        self.boundary
     }
 }
 
@@ -136,11 +143,23 @@ impl Flow {
 
     /// Spreads the force `f` \[N\] acting on the fluid at point `x` over the velocity nodes around it with
     /// the trilinear weights of [`Flow::velocity_at`] (the same stencil the particles sample), as
-    /// accelerations f w/(ρ V_node). Nodes the momentum equation does not update (closed sides, faces of
-    /// blocked cells, nodes inside solids) take no share and the weights of the others are renormalised;
-    /// when no node of a component's stencil is updated, that component goes whole to the nearest node
-    /// that is. In axisymmetric mode `f` is per radian (r, axial, 0). Returns `false` (and adds nothing)
-    /// when `x` lies outside the grid or no updated node lies near it.
+    /// accelerations f w/(ρ V_node).
+    ///
+    /// Two kinds of stencil node are not updated by the momentum equation, and they are treated apart:
+    /// * a **boundary face** (the normal velocity on a face between a fluid cell and a side of the domain
+    ///   or a blocked cell: inlet, wall, slip, symmetry, outlet or solid face) carries its share: that
+    ///   force acts on the fluid between the node and the first pressure point, where the boundary's
+    ///   pressure balances it (a bed resting on an inlet pushes on the inlet, a stone beside a pipe wall on
+    ///   the wall). Moving it onto the next interior face instead would put the force of the half cell
+    ///   beside the boundary onto one face, whose pressure jump the particles then sample (the model A
+    ///   pressure-gradient force feeds back on itself there): a fluidised bed resting on the inlet showed
+    ///   2.4 times Ergun's pressure drop that way (docs/cfd.md, minimum fluidisation);
+    /// * other nodes (tangential ghost nodes outside the domain, nodes inside solids) take no share and the
+    ///   weights of the updated nodes are renormalised.
+    ///
+    /// When no node of a component's stencil is updated or a boundary face, that component goes whole to the
+    /// nearest updated node. In axisymmetric mode `f` is per radian (r, axial, 0). Returns `None` when `x`
+    /// lies outside the grid or no updated node lies near it.
     pub fn add_point_force(&mut self, x: [f64; 3], f: [f64; 3]) -> bool {
         match self.point_force_shares(x, f) {
             Some(shares) => {
@@ -164,7 +183,7 @@ impl Flow {
             }
         }
         let rho = self.fluid.density;
-        let mut out = PointForce { adds: [(0, 0, 0.0); 24], len: 0 };
+        let mut out = PointForce { adds: [(0, 0, 0.0); 24], len: 0, boundary: [0.0; 3] };
         for comp in 0..3 {
             if f[comp] == 0.0 {
                 continue;
@@ -172,7 +191,7 @@ impl Flow {
             let (base, w) = crate::solver::trilinear_stencil(g, comp, x);
             // Only nodes the momentum equation updates take a share; the weights are renormalised.
             let mut nodes = [(0usize, 0.0f64); 8];
-            let (mut count, mut total) = (0, 0.0);
+            let (mut count, mut total, mut on_boundary) = (0, 0.0, 0.0);
             for dk in 0..2 {
                 for dj in 0..2 {
                     for di in 0..2 {
@@ -180,15 +199,22 @@ impl Flow {
                         let wt = (if di == 1 { w[0] } else { 1.0 - w[0] })
                             * (if dj == 1 { w[1] } else { 1.0 - w[1] })
                             * (if dk == 1 { w[2] } else { 1.0 - w[2] });
-                        if wt > 0.0 && self.is_active_node(comp, c) {
+                        if wt <= 0.0 {
+                            continue;
+                        }
+                        if self.is_active_node(comp, c) {
                             nodes[count] = (c, wt);
                             count += 1;
                             total += wt;
+                        } else if self.is_boundary_face(comp, c) {
+                            on_boundary += wt;
                         }
                     }
                 }
             }
-            if count == 0 {
+            total += on_boundary;
+            out.boundary[comp] = if total > 0.0 { f[comp] * on_boundary / total } else { 0.0 };
+            if count == 0 && on_boundary == 0.0 {
                 // No node of the stencil is updated (a point next to or inside blocked cells, or on a
                 // closed side): the whole component goes to the nearest node that is, so that the fluid
                 // still receives exactly the force.
@@ -208,6 +234,17 @@ impl Flow {
             }
         }
         Some(out)
+    }
+
+    /// Whether velocity node `c` of component `comp` lies on a boundary face: the face between cell `c`
+    /// and its +`comp` neighbour, with exactly one of the two a fluid cell.
+    fn is_boundary_face(&self, comp: usize, c: usize) -> bool {
+        let l = self.grid.layout;
+        let q = l.coords(c);
+        if q[comp] + 1 >= l.p[comp] {
+            return false;
+        }
+        self.is_fluid(c) != self.is_fluid(c + l.s[comp])
     }
 
     /// The updated (active) velocity node of component `comp` nearest to `x` among the 4 × 4 × 4 nodes
@@ -276,8 +313,9 @@ mod tests {
 
     /// A sphere beside a blocked wall (its stencil partly in the solid) and one whose centre lies inside
     /// the first layer of blocked cells (every node of some components' stencils in the solid, the case
-    /// that lost momentum in the coupled gravelometer pipe): the fluid receives exactly the forces
-    /// (Σ ρ V a = Σ f to round-off, 1e-12), all of it on updated nodes.
+    /// that lost momentum in the coupled gravelometer pipe): the fluid and the solid's faces together
+    /// receive exactly the forces (Σ ρ V a + Σ boundary shares = Σ f to round-off, 1e-12), the fluid's
+    /// part all on updated nodes.
     #[test]
     fn point_forces_next_to_and_inside_blocked_cells_keep_their_whole_force() {
         let g = Grid::uniform_box([0.0; 3], [8.0; 3], [8, 8, 8]).unwrap();
@@ -300,9 +338,13 @@ mod tests {
             assert!(shares.nodes().iter().all(|&(a, c, _)| f.is_active_node(a as usize, c)));
             f.apply_point_force(&shares);
             for a in 0..3 {
-                want[a] += force[a];
+                want[a] += force[a] - shares.on_boundaries()[a];
             }
         }
+        // The sphere inside the solid (x = 4.6 m, solid from 4 m): its x stencil has the solid face at
+        // x = 4 m (weight 0.4) and a node inside the solid (no share), so the wall carries all of f_x.
+        let inside = f.point_force_shares([4.6, 2.2, 5.7], [-3.0, 0.25, 2.0]).unwrap();
+        assert!((inside.on_boundaries()[0] + 3.0).abs() < 1e-12, "{:?}", inside.on_boundaries());
         let t = f.total_body_force();
         for a in 0..3 {
             assert!((t[a] - want[a]).abs() < 1e-12, "{t:?} vs {want:?}");
@@ -329,12 +371,18 @@ mod tests {
             Numerics::default(),
         )
         .unwrap();
-        assert!(f.add_point_force([0.31, 0.52, 0.17], [2.0, -1.0, 0.5]));
-        // Next to a wall some stencil nodes are boundary nodes: the weights are renormalised.
-        assert!(f.add_point_force([0.01, 0.99, 0.02], [0.0, 3.0, 0.0]));
+        let inner = f.point_force_shares([0.31, 0.52, 0.17], [2.0, -1.0, 0.5]).unwrap();
+        assert_eq!(inner.on_boundaries(), [0.0; 3], "away from the walls nothing goes to them");
+        f.apply_point_force(&inner);
+        // Next to the wall y = 1 (7 cells of 1/7 m): the y nodes around y = 0.99 m are the face at
+        // 6/7 m (weight (1 − 0.99)·7 = 0.07, updated) and the wall face at 1 m (weight 0.93), so the
+        // wall carries 0.93 of f_y (the x and z stencils have tangential ghost nodes: renormalised).
+        let edge = f.point_force_shares([0.01, 0.99, 0.02], [0.0, 3.0, 0.0]).unwrap();
+        assert!((edge.on_boundaries()[1] - 0.93 * 3.0).abs() < 1e-12, "{:?}", edge.on_boundaries());
+        f.apply_point_force(&edge);
         assert!(!f.add_point_force([1.5, 0.5, 0.2], [1.0, 0.0, 0.0]), "outside");
         let t = f.total_body_force();
-        for (a, want) in [2.0, 2.0, 0.5].iter().enumerate() {
+        for (a, want) in [2.0, -1.0 + 3.0 * 0.07, 0.5].iter().enumerate() {
             assert!((t[a] - want).abs() < 1e-12, "{t:?}");
         }
     }

@@ -119,7 +119,11 @@ pub struct ExchangeReport {
     pub from_particles: Vec3,
     /// Σ ρ V a of the body force the fluid received \[N\].
     pub to_fluid: Vec3,
-    /// |to_fluid + from_particles| / max(|from_particles|, 1e-300).
+    /// The part of the spheres' reaction that boundary faces carry (spheres within half a cell of an inlet,
+    /// outlet, wall or solid face; [`spatter_cfd::sources::PointForce::on_boundaries`]) \[N\].
+    #[serde(default)]
+    pub to_boundaries: Vec3,
+    /// |to_fluid + to_boundaries + from_particles| / max(|from_particles|, 1e-300).
     pub relative_mismatch: f64,
     /// Spheres outside the grid (no fluid force).
     pub outside: u64,
@@ -327,6 +331,7 @@ impl Coupling {
             force.iter_mut().for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
         }
         let mut from = Vec3::ZERO;
+        let mut on_boundaries = Vec3::ZERO;
         let mut outside = 0;
         for i in 0..n {
             if !self.inside[i] {
@@ -337,6 +342,7 @@ impl Coupling {
                 Some(sh) => {
                     self.flow.apply_point_force(sh);
                     from += self.exchanged[i];
+                    on_boundaries += Vec3::from(sh.on_boundaries());
                 }
                 None => outside += 1,
             }
@@ -345,9 +351,15 @@ impl Coupling {
         ext.copy_from_slice(&self.on_particles);
         let to = Vec3::from(self.flow.total_body_force());
         let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
-        let rel = (to + from).length() / from.length().max(1e-300);
-        self.last =
-            ExchangeReport { from_particles: from, to_fluid: to, relative_mismatch: rel, outside, alpha_min };
+        let rel = (to + on_boundaries + from).length() / from.length().max(1e-300);
+        self.last = ExchangeReport {
+            from_particles: from,
+            to_fluid: to,
+            to_boundaries: on_boundaries,
+            relative_mismatch: rel,
+            outside,
+            alpha_min,
+        };
         let t3 = Instant::now();
         self.times.void_fraction += (t1 - t0).as_secs_f64();
         self.times.forces += (t3 - t1).as_secs_f64();

@@ -181,17 +181,21 @@ fn layer_pressure(flow: &Flow, a: usize, layer: usize) -> f64 {
 }
 
 /// The pressure drop across the grid along gravity \[Pa\]: mean pressure of the bottom cell layer (the
-/// end gravity points to) minus that of the top layer. The solver's pressure excludes the hydrostatic
-/// part, so for a fluidised bed this is the bed's weight less buoyancy per unit area.
-fn pressure_drop(flow: &Flow, g: Vec3) -> f64 {
+/// end gravity points to) minus that of the top layer, plus the spheres' force that boundary faces carry
+/// (`on_boundaries`, \[N\], from the last exchange) along gravity per cross-section area — the force on
+/// the fluid between the bottom face and the first layer's centre, so that the sum is the drop from face to
+/// face. The solver's pressure excludes the hydrostatic part, so for a fluidised bed this is the bed's
+/// weight less buoyancy per unit area.
+pub(super) fn pressure_drop(flow: &Flow, g: Vec3, on_boundaries: Vec3) -> f64 {
     let (a, down_is_low) = gravity_axis(g);
     let n = flow.grid.layout.n[a];
     let (lo, hi) = (layer_pressure(flow, a, 0), layer_pressure(flow, a, n - 1));
-    if down_is_low {
-        lo - hi
-    } else {
-        hi - lo
-    }
+    let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+    let ax = &flow.grid.axes;
+    let section = (ax[b].hi() - ax[b].lo()) * (ax[c].hi() - ax[c].lo());
+    let down = if down_is_low { -1.0 } else { 1.0 };
+    let carried = down * on_boundaries.to_array()[a] / section;
+    carried + if down_is_low { lo - hi } else { hi - lo }
 }
 
 /// Twice the volume-weighted mean height of the sphere centres above the grid's bottom along gravity
@@ -400,7 +404,7 @@ fn drive<L: ContactLaw>(
                 t,
                 st.coupling_steps as f64,
                 c.dem.particles.len() as f64,
-                pressure_drop(&c.flow, gravity),
+                pressure_drop(&c.flow, gravity, st.last.to_boundaries),
                 bed_height(&c.dem, &c.flow),
                 pm.x,
                 pm.y,
@@ -432,7 +436,7 @@ fn drive<L: ContactLaw>(
                  momentum mismatch {:.2e} (largest so far {:.2e}), smallest α {:.4}",
                 st.coupling_steps,
                 c.dem.particles.len(),
-                pressure_drop(&c.flow, gravity),
+                pressure_drop(&c.flow, gravity, st.last.to_boundaries),
                 bed_height(&c.dem, &c.flow),
                 st.last.relative_mismatch,
                 st.max_mismatch,
@@ -610,7 +614,7 @@ fn finish<L: ContactLaw>(
     s.artifacts.push(("fluid fields (ParaView)".into(), dir.path("fields.pvd")));
     s.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
     s.artifacts.push(("series".into(), series_path));
-    let dp = pressure_drop(flow, c.dem.gravity);
+    let dp = pressure_drop(flow, c.dem.gravity, st.last.to_boundaries);
     let h = bed_height(&c.dem, flow);
     let (pm, ke) = particle_momentum(&c.dem);
     let (cost_line, cost_scalars) = st.times.cost_report(st.coupling_steps, st.pressure_iterations);

