@@ -196,9 +196,11 @@ impl Validate for WadingConfig {
 }
 
 impl spatter_io::run::Smoke for WadingConfig {
-    /// Spacing doubled (an eighth of the particles) and 20 ms of simulated time, two snapshots.
+    /// Spacing doubled (an eighth of the particles) but kept to at most a third of the water depth (three
+    /// particles over the depth, so that the pool still fills), and 20 ms of simulated time, two snapshots.
     fn smoke(&mut self) {
-        self.fluid.spacing_m *= 2.0;
+        let coarse = (2.0 * self.fluid.spacing_m).min(self.channel.water_depth_m / 3.0);
+        self.fluid.spacing_m = self.fluid.spacing_m.max(coarse);
         let end = self.output.end_time_s.unwrap_or(f64::INFINITY).min(0.02);
         self.output.end_time_s = Some(end);
         self.output.vtu_interval_s = Some(end / 2.0);
