@@ -15,14 +15,23 @@ fn vtk_available() -> bool {
     Command::new(PYTHON).args(["-c", "import vtk"]).output().map(|o| o.status.success()).unwrap_or(false)
 }
 
+/// Whether VTK can be used; without it the test reports that it skipped, and with `SPATTER_REQUIRE_VTK`
+/// set a missing VTK is a failure.
+fn vtk_or_skip() -> bool {
+    if vtk_available() {
+        return true;
+    }
+    assert!(
+        std::env::var("SPATTER_REQUIRE_VTK").is_err(),
+        "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
+    );
+    eprintln!("skipped: python3-vtk9 is not installed");
+    false
+}
+
 #[test]
 fn vtk_reads_particles_and_meshes() {
-    if !vtk_available() {
-        assert!(
-            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
-            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
-        );
-        eprintln!("skipped: python3-vtk9 is not installed");
+    if !vtk_or_skip() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -74,12 +83,7 @@ print("ok")
 
 #[test]
 fn vtk_reads_rectilinear_grids() {
-    if !vtk_available() {
-        assert!(
-            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
-            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
-        );
-        eprintln!("skipped: python3-vtk9 is not installed");
+    if !vtk_or_skip() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -124,12 +128,7 @@ print("ok")
 /// Pieces written on several ranks and the `.pvtu` joining them read as one data set of every particle.
 #[test]
 fn vtk_reads_pieces_through_a_pvtu() {
-    if !vtk_available() {
-        assert!(
-            std::env::var("SPATTER_REQUIRE_VTK").is_err(),
-            "SPATTER_REQUIRE_VTK is set but `import vtk` fails"
-        );
-        eprintln!("skipped: python3-vtk9 is not installed");
+    if !vtk_or_skip() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
