@@ -4,6 +4,7 @@
 //!   the rotor downwash model of [`rotor`], summed;
 //! * [`imported`] — CFD results read from VTK files, located and interpolated on a conforming
 //!   tetrahedral decomposition ([`tetmesh`], [`decompose`]);
+//! * [`scaled`] — a model-scale rotor flow carried to full scale by R and v_ind;
 //! * [`dispersion`] — turbulent dispersion by a discrete random walk driven by k and ε.
 //!
 //! Every field implements [`FlowField`]: the velocity at a point and time, optionally its gradient,
@@ -14,6 +15,7 @@ pub mod decompose;
 pub mod dispersion;
 pub mod imported;
 pub mod rotor;
+pub mod scaled;
 pub use spatter_core::special;
 pub mod tetmesh;
 pub mod wall_jet;

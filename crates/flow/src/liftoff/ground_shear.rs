@@ -145,10 +145,45 @@ pub fn shields_exceedance<F: FlowField>(
     theta_c: f64,
 ) -> Vec<f64> {
     let series: Vec<Vec<GroundShear>> = times.iter().map(|&t| ground_shear(field, probe, t, fluid)).collect();
-    (0..probe.distances.len())
+    exceedance_table(&series, &[d], rho_p, g, theta_c).into_iter().map(|row| row[0].fraction).collect()
+}
+
+/// Shields statistics of one grain size at one ground point over a time series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exceedance {
+    /// Fraction of the samples with θ > θ* \[-\].
+    pub fraction: f64,
+    /// Mean and largest Shields parameter over the samples \[-\].
+    pub mean: f64,
+    pub max: f64,
+}
+
+/// Shields exceedance at every ground point (outer index) for every diameter of `diameters` (inner
+/// index) from a time series of wall shear: `series[k]` is [`ground_shear`] at the k-th of equally
+/// spaced times.
+pub fn exceedance_table(
+    series: &[Vec<GroundShear>],
+    diameters: &[f64],
+    rho_p: f64,
+    g: f64,
+    theta_c: f64,
+) -> Vec<Vec<Exceedance>> {
+    let points = series.first().map_or(0, Vec::len);
+    let n = series.len().max(1) as f64;
+    (0..points)
         .map(|i| {
-            let theta: Vec<f64> = series.iter().map(|s| shields_parameter(s[i].tau_w, rho_p, g, d)).collect();
-            fraction_above(&theta, theta_c)
+            diameters
+                .iter()
+                .map(|&d| {
+                    let theta: Vec<f64> =
+                        series.iter().map(|s| shields_parameter(s[i].tau_w, rho_p, g, d)).collect();
+                    Exceedance {
+                        fraction: fraction_above(&theta, theta_c),
+                        mean: theta.iter().sum::<f64>() / n,
+                        max: theta.iter().copied().fold(0.0, f64::max),
+                    }
+                })
+                .collect()
         })
         .collect()
 }
@@ -201,6 +236,44 @@ mod tests {
         // Below the threshold where 1 + ½ sin < 2/3, i.e. sin < −2/3: a fraction ½ − asin(2/3)/π.
         let below = 0.5 - (2.0f64 / 3.0).asin() / std::f64::consts::PI;
         assert!((frac[0] - (1.0 - below)).abs() < 3.0 / 400.0, "{} vs {}", frac[0], 1.0 - below);
+    }
+
+    #[test]
+    fn exceedance_of_a_sinusoidal_friction_velocity_is_the_arccos_fraction() {
+        // A flow whose speed at 0.1 m pulses as U(t) = U₀(1 + ½ sin 2πt): the friction velocity of the
+        // wall function grows monotonically with U, so θ > θ* exactly while U > U*, the speed whose
+        // wall-function u* gives θ*: while sin 2πt > s* = 2(U*/U₀ − 1), a fraction arccos(s*)/π of the
+        // period (analytic). 2000 equally spaced samples: tolerance 1/2000 + rounding.
+        let fluid = Fluid { density: 1.19, viscosity: 1.82e-5 };
+        let probe = GroundProbe {
+            origin: Vec3::ZERO,
+            direction: Vec3::X,
+            distances: vec![1.0, 2.0],
+            method: ShearMethod::FixedHeight { height: 0.1 },
+            gust: 1.0,
+        };
+        let f = Pulsing(6.0);
+        let n = 2000;
+        let series: Vec<Vec<GroundShear>> =
+            (0..n).map(|k| ground_shear(&f, &probe, (k as f64 + 0.5) / n as f64, &fluid)).collect();
+        let (rho_p, g) = (2480.0, 9.81);
+        let diameters = [10e-6, 50e-6, 150e-6, 500e-6];
+        let theta_c = super::super::shields::SHIELDS_MIXED;
+        let table = exceedance_table(&series, &diameters, rho_p, g, theta_c);
+        assert_eq!(table.len(), 2);
+        for (k, &d) in diameters.iter().enumerate() {
+            let u_star_c = (theta_c * rho_p * g * d / fluid.density).sqrt();
+            let u_c = super::super::wall_law::speed_at(0.1, u_star_c, fluid.nu());
+            let s = (2.0 * (u_c / 6.0 - 1.0)).clamp(-1.0, 1.0);
+            let expect = s.acos() / std::f64::consts::PI;
+            let e = table[0][k];
+            assert!((e.fraction - expect).abs() <= 1.0 / n as f64 + 1e-12, "{d}: {} vs {expect}", e.fraction);
+            assert_eq!(e, table[1][k], "a uniform flow is the same at both points");
+            assert!(e.max >= e.mean && e.mean > 0.0);
+        }
+        // The four sizes span the cases: always above, partly, and never above the threshold.
+        let f: Vec<f64> = table[0].iter().map(|e| e.fraction).collect();
+        assert!(f[0] == 1.0 && f[1] > 0.0 && f[1] < 1.0 && f[2] < f[1] && f[3] == 0.0, "{f:?}");
     }
 
     #[test]
