@@ -179,8 +179,16 @@ impl Validate for DemBedConfig {
                     c.fail("layers", format!("layers = {} must be 1 to 100", self.layers));
                 }
             }
-            // The bed file is read when the run starts (paths are resolved after validation).
-            (Some(_), None) => {}
+            // The bed file is read here too (resolved against the scenario's folder), so `spatter check`
+            // refuses a missing or garbled one; the run reads it again from its absolute path.
+            (Some(p), None) => {
+                let full = c.resolve(p);
+                if !full.is_file() && !full.is_dir() {
+                    c.file_exists("file", p);
+                } else if let Err(e) = read_bed_file(&full) {
+                    c.fail("file", format!("file = \"{}\": {e}", p.display()));
+                }
+            }
         }
         if let Some(k) = self.stiffness_n_m {
             c.positive("stiffness_n_m", k);
@@ -347,6 +355,9 @@ impl BedFlow {
         });
         let mut forces = BedFlowForces::new(flow, fluid, density, z_ground, cfg.forces);
         forces.t0 = t0;
+        // The probe (friction velocity, exposed grains) at the flow's start, for the first output row.
+        let p = &sim.particles;
+        forces.observe(sim.time(), &p.pos, &p.radius, &p.inv_mass);
         let probe = forces.probe.clone();
         sim.set_external_forces(Box::new(forces));
         Ok(BedFlow {

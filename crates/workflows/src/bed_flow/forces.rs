@@ -148,16 +148,30 @@ impl<G: GroundFlow> BedFlowForces<G> {
     }
 }
 
-impl<G: GroundFlow> ExternalForces for BedFlowForces<G> {
-    fn add(&mut self, time: f64, p: &ParticleView, force: &mut [Vec3], _torque: &mut [Vec3]) {
+impl<G: GroundFlow> BedFlowForces<G> {
+    /// The flow's friction velocity and direction at DEM time `time`; finds the exposed grains (kept for
+    /// the force evaluation) and records both in the probe.
+    pub fn observe(&mut self, time: f64, pos: &[Vec3], radius: &[f64], inv_mass: &[f64]) -> (f64, Vec3) {
         let (u_star, dir) = self.flow.shear(time - self.t0);
         self.active.clear();
-        self.active.extend(p.inv_mass.iter().map(|&im| im > 0.0));
+        self.active.extend(inv_mass.iter().map(|&im| im > 0.0));
         let mut exposed = std::mem::take(&mut self.exposed);
-        exposure(p.pos, p.radius, &self.active, dir, self.z_ground, &mut self.scratch, &mut exposed);
+        exposure(pos, radius, &self.active, dir, self.z_ground, &mut self.scratch, &mut exposed);
+        let count = exposed.iter().filter(|&&e| e).count();
+        self.exposed = exposed;
+        if let Ok(mut probe) = self.probe.lock() {
+            *probe = BedFlowProbe { time: time - self.t0, u_star, exposed: count };
+        }
+        (u_star, dir)
+    }
+}
+
+impl<G: GroundFlow> ExternalForces for BedFlowForces<G> {
+    fn add(&mut self, time: f64, p: &ParticleView, force: &mut [Vec3], _torque: &mut [Vec3]) {
+        let (u_star, dir) = self.observe(time, p.pos, p.radius, p.inv_mass);
         let this = &*self;
         force.par_iter_mut().enumerate().for_each(|(i, f)| {
-            if exposed[i] {
+            if this.exposed[i] {
                 let m = 1.0 / p.inv_mass[i];
                 *f += this.grain_force(
                     p.radius[i],
@@ -170,10 +184,5 @@ impl<G: GroundFlow> ExternalForces for BedFlowForces<G> {
                 );
             }
         });
-        let count = exposed.iter().filter(|&&e| e).count();
-        self.exposed = exposed;
-        if let Ok(mut probe) = self.probe.lock() {
-            *probe = BedFlowProbe { time: time - self.t0, u_star, exposed: count };
-        }
     }
 }

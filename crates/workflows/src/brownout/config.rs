@@ -13,6 +13,7 @@ use spatter_flow::liftoff::incipient::{PullOff, RockingSettings};
 
 pub use crate::bed_flow::DemBedConfig;
 
+pub use super::imported::{ImportedFlowConfig, ModelScale};
 pub use super::rans::{FlowChoice, RansConfig, RansTurbulence};
 
 /// A `brownout` scenario.
@@ -254,6 +255,22 @@ pub struct LiftoffConfig {
     /// Wall-bounded lift law.
     #[serde(default = "regimes")]
     pub wall_lift: WallLiftLaw,
+    /// Critical Shields parameter θ* of the exceedance map (Jasion's τ_ref = 0.03 ρ_p g D).
+    #[serde(default = "shields_mixed")]
+    pub shields_critical: f64,
+    /// Times over the unsteady window at which the exceedance map samples the wall shear.
+    #[serde(default = "exceedance_samples")]
+    pub exceedance_samples: usize,
+    /// Factor on the ground speeds of the exceedance map (1: the unsteady field as it is).
+    #[serde(default = "one")]
+    pub exceedance_gust_factor: f64,
+}
+
+fn shields_mixed() -> f64 {
+    spatter_flow::liftoff::shields::SHIELDS_MIXED
+}
+fn exceedance_samples() -> usize {
+    64
 }
 
 fn gust() -> f64 {
@@ -285,6 +302,9 @@ impl Default for LiftoffConfig {
             points: points(),
             diameters_m: map_diameters(),
             wall_lift: regimes(),
+            shields_critical: shields_mixed(),
+            exceedance_samples: exceedance_samples(),
+            exceedance_gust_factor: one(),
         }
     }
 }
@@ -303,6 +323,14 @@ impl Validate for LiftoffConfig {
         if self.diameters_m.is_empty() || self.diameters_m.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
             c.fail("diameters_m", "diameters_m must list positive diameters in metres");
         }
+        c.positive("shields_critical", self.shields_critical);
+        if !(1..=10_000).contains(&self.exceedance_samples) {
+            c.fail(
+                "exceedance_samples",
+                format!("exceedance_samples = {} must be 1 to 10000", self.exceedance_samples),
+            );
+        }
+        c.positive("exceedance_gust_factor", self.exceedance_gust_factor);
     }
 }
 
@@ -503,11 +531,11 @@ impl Validate for BrownoutConfig {
     fn validate(&self, c: &mut Checker) {
         c.item("rotor", &self.rotor);
         c.item("flow", &self.flow);
-        if matches!(self.flow, FlowChoice::Rans(_)) && self.rotor.tip_vortices {
+        if !matches!(self.flow, FlowChoice::Analytic) && self.rotor.tip_vortices {
             c.nested("rotor", |c| {
                 c.fail(
                     "tip_vortices",
-                    "tip_vortices = true: the analytic tip vortices belong to flow.kind = \"analytic\"; the RANS flow is the mean flow (set tip_vortices = false)",
+                    "tip_vortices = true: the analytic tip vortices belong to flow.kind = \"analytic\"; a RANS flow is the mean flow and an imported field carries its own vortices (set tip_vortices = false)",
                 )
             });
         }
@@ -594,6 +622,7 @@ impl spatter_io::run::Smoke for BrownoutConfig {
         self.output.interval_s = self.output.interval_s.min(2.0 * self.cloud.dt_s);
         self.output.grid_cells = [8, 8, 4];
         self.liftoff.points = self.liftoff.points.min(8);
+        self.liftoff.exceedance_samples = self.liftoff.exceedance_samples.min(4);
         self.entrainment.annuli = self.entrainment.annuli.min(6);
         self.entrainment.phases = self.entrainment.phases.min(2);
         if let Some(b) = &mut self.dem_bed {

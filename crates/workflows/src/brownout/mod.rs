@@ -6,6 +6,8 @@
 //! results compare with Jasion (2013).
 
 pub mod config;
+pub mod exceedance;
+pub mod imported;
 pub mod rans;
 pub mod run;
 

@@ -25,6 +25,8 @@ pub enum FlowChoice {
     Analytic,
     /// The axisymmetric RANS flow solved at the start of the run.
     Rans(RansConfig),
+    /// A field imported from VTK files, optionally at model scale (scaled by R and v_ind).
+    Imported(super::imported::ImportedFlowConfig),
 }
 
 /// Turbulence model of the RANS solve.
@@ -139,8 +141,10 @@ impl Validate for RansConfig {
 
 impl Validate for FlowChoice {
     fn validate(&self, c: &mut Checker) {
-        if let FlowChoice::Rans(r) = self {
-            r.validate(c);
+        match self {
+            FlowChoice::Analytic => {}
+            FlowChoice::Rans(r) => r.validate(c),
+            FlowChoice::Imported(i) => i.validate(c),
         }
     }
 }

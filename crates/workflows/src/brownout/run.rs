@@ -114,8 +114,49 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
             let mean_field = AnalyticSet { parts: vec![AnalyticField::Rotor(mean_rotor)], turbulence: None };
             // With tip vortices the flux (nonlinear in u_*) is averaged over one shedding period; the mean
             // flow is steady and needs one sample.
-            let phases = if rotor.tip_vortices { cfg.entrainment.phases } else { 1 };
-            run_on(cfg, ctx, field, &mean_field, phases, summary)
+            let window = if rotor.tip_vortices {
+                let period = std::f64::consts::TAU / (cfg.rotor.blades as f64 * cfg.rotor.omega_rad_s);
+                Unsteady { start: 0.0, span: period, phases: cfg.entrainment.phases }
+            } else {
+                Unsteady::STEADY
+            };
+            run_on(cfg, ctx, field, &mean_field, window, summary)
+        }
+        FlowChoice::Imported(ic) => {
+            let loaded = super::imported::load(cfg, ic)
+                .map_err(|e| BrownoutError::Invalid(vec![Invalid { key: "flow".into(), message: e }]))?;
+            let mut summary = summary;
+            let s = loaded.field.scaling;
+            summary.headline.push(format!(
+                "imported flow: {} frame(s); scaled to the rotor by lengths × {:.6}, velocities × {:.6}, times × {:.6}{}",
+                loaded.frames,
+                s.length,
+                s.velocity,
+                s.time(),
+                if loaded.frames > 1 {
+                    format!("; unsteady window {:.4} s from t = {:.4} s (full scale)", loaded.window.1, loaded.window.0)
+                } else {
+                    String::new()
+                }
+            ));
+            summary.scalar("flow_length_scale", s.length);
+            summary.scalar("flow_velocity_scale", s.velocity);
+            let field = &loaded.field;
+            if loaded.frames > 1 && loaded.window.1 > 0.0 {
+                let window = Unsteady {
+                    start: loaded.window.0,
+                    span: loaded.window.1,
+                    phases: cfg.entrainment.phases,
+                };
+                // The lift-off map's mean flow: the field averaged over the exceedance map's times.
+                let mean = super::imported::TimeMean {
+                    inner: field,
+                    times: window.times(cfg.liftoff.exceedance_samples),
+                };
+                run_on(cfg, ctx, field, &mean, window, summary)
+            } else {
+                run_on(cfg, ctx, field, field, Unsteady::STEADY, summary)
+            }
         }
         FlowChoice::Rans(rc) => {
             let started = std::time::Instant::now();
@@ -130,7 +171,7 @@ pub fn run(cfg: &BrownoutConfig, ctx: &RunContext) -> Result<RunSummary, Brownou
             let summary = rans_outputs(cfg, ctx, &solved, started.elapsed().as_secs_f64(), summary)?;
             let field = SolvedField::new(&solved.flow);
             let mean_field = SolvedField::new(&solved.flow);
-            run_on(cfg, ctx, field, &mean_field, 1, summary)
+            run_on(cfg, ctx, field, &mean_field, Unsteady::STEADY, summary)
         }
     }
 }
@@ -218,15 +259,40 @@ fn rans_outputs(
     Ok(summary)
 }
 
+/// The time window over which an unsteady field is sampled: one shedding period of the analytic tip
+/// vortices, or the period (else the span) of an imported time series.
+#[derive(Clone, Copy, Debug)]
+struct Unsteady {
+    /// Start \[s\] and length \[s\] of the window (0: a steady field).
+    start: f64,
+    span: f64,
+    /// Times at which the source's flux is averaged (1: a steady field).
+    phases: usize,
+}
+
+impl Unsteady {
+    const STEADY: Unsteady = Unsteady { start: 0.0, span: 0.0, phases: 1 };
+
+    /// `n` equally spaced times over the window, from its start (one time for a steady field).
+    fn times(&self, n: usize) -> Vec<f64> {
+        if self.span > 0.0 {
+            (0..n).map(|k| self.start + self.span * k as f64 / n as f64).collect()
+        } else {
+            vec![self.start]
+        }
+    }
+}
+
 /// The lift-off map, the source and the cloud on `field` (the lift-off map on `mean_field`).
 fn run_on<F: FlowField, M: FlowField>(
     cfg: &BrownoutConfig,
     ctx: &RunContext,
     field: F,
     mean_field: &M,
-    phases: usize,
+    window: Unsteady,
     mut summary: RunSummary,
 ) -> Result<RunSummary, BrownoutError> {
+    let phases = window.phases;
     let air = cfg.air;
     let r0 = cfg.rotor.radius_m;
     let g = 9.81;
@@ -282,6 +348,7 @@ fn run_on<F: FlowField, M: FlowField>(
         at_best / r0
     ));
     summary.scalar("most_liftable_diameter_um", map.diameters[k_best] * 1e6);
+    super::exceedance::write(cfg, ctx, &field, &probe, window.times(lo.exceedance_samples), &mut summary)?;
 
     // 2. The entrainment source on annuli.
     let en = &cfg.entrainment;
@@ -299,11 +366,9 @@ fn run_on<F: FlowField, M: FlowField>(
     };
     // With tip vortices the flux (nonlinear in u_*) is averaged over one shedding period, sampled at
     // `phases` equally spaced times.
-    let period = std::f64::consts::TAU / (cfg.rotor.blades as f64 * cfg.rotor.omega_rad_s);
     let mut ground: Vec<GroundShear> = Vec::new();
     let mut rates: Vec<Vec<f64>> = Vec::new();
-    for k in 0..phases {
-        let t = period * k as f64 / phases as f64;
+    for (k, t) in window.times(phases).into_iter().enumerate() {
         let gs = ground_shear(&field, &src_probe, t, &air);
         let reference: Vec<f64> = ground_shear(&field, &ref_probe, t, &air).iter().map(|g| g.speed).collect();
         let r = entrainment_rates(
@@ -485,15 +550,20 @@ fn run_on<F: FlowField, M: FlowField>(
         *k += 1;
         Ok(())
     };
-    let write_bed = |bed: &Option<BedFlow>, csv: &mut Option<CsvSeries>| -> std::io::Result<()> {
+    // The bed's rows: at t = 0, at every output time while the patch runs, and once when it ends (the
+    // patch may end between two output times; after its end nothing changes).
+    let bed_ended = |b: &BedFlow| b.flow_time() + 0.5 * b.sim.dt >= bed_duration;
+    let write_bed = |bed: &Option<BedFlow>, csv: &mut Option<CsvSeries>, last: bool| -> std::io::Result<()> {
         if let (Some(b), Some(csv)) = (bed, csv) {
-            csv.row(&bed_row(b))?;
+            if last || !bed_ended(b) {
+                csv.row(&bed_row(b))?;
+            }
         }
         Ok(())
     };
     if sim.tracker.state.step == 0 && next_output == 0 {
         write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
-        write_bed(&bed, &mut bed_csv)?;
+        write_bed(&bed, &mut bed_csv, false)?;
     }
     let due = |t: f64, k: u64| t >= k as f64 * interval - 1e-9 * dt;
     let mut last_written = u64::MAX;
@@ -526,7 +596,9 @@ fn run_on<F: FlowField, M: FlowField>(
                 return Ok(s);
             }
         }
+        let mut bed_just_ended = false;
         if let Some(b) = &mut bed {
+            let running = !bed_ended(b);
             // The bed runs over this cloud step; the grains that left it join the cloud at the step's
             // start, at their place on the ground (bed frame: ground plane at z = 0, patch centre at
             // the patch's place), with their own velocity.
@@ -535,6 +607,7 @@ fn run_on<F: FlowField, M: FlowField>(
             while b.flow_time() + 0.5 * dtb < target {
                 b.step(&mut released).map_err(|e| BrownoutError::Checkpoint(format!("DEM bed: {e}")))?;
             }
+            bed_just_ended = running && bed_ended(b);
             let [x0, x1, y0, y1] = b.footprint;
             let origin = Vec3::new(0.5 * (x0 + x1), 0.5 * (y0 + y1), b.z_ground);
             for r in released.drain(..) {
@@ -551,16 +624,19 @@ fn run_on<F: FlowField, M: FlowField>(
             }
         }
         sim.step()?;
-        if due(sim.tracker.state.time, next_output) {
+        let output = due(sim.tracker.state.time, next_output);
+        if output {
             write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
-            write_bed(&bed, &mut bed_csv)?;
             last_written = sim.tracker.state.step;
+        }
+        if output || bed_just_ended {
+            write_bed(&bed, &mut bed_csv, bed_just_ended)?;
         }
         ctx.control.progress(sim.tracker.state.step, n_steps);
     }
     if last_written != sim.tracker.state.step {
         write_outputs(&sim, &mut next_output, &mut bal_csv, &mut opt_csv, &mut pvd)?;
-        write_bed(&bed, &mut bed_csv)?;
+        write_bed(&bed, &mut bed_csv, false)?;
     }
     bal_csv.flush()?;
     opt_csv.flush()?;

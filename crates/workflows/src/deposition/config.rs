@@ -242,7 +242,7 @@ pub const BYTES_PER_PARCEL: u64 = 400;
 
 /// `path` must name a VTK file the flow reader accepts (legacy or XML, sizes consistent, coordinates
 /// finite); the message names the key and the file.
-fn vtk_file(c: &mut Checker, key: &str, path: &Path) {
+pub(crate) fn vtk_file(c: &mut Checker, key: &str, path: &Path) {
     let full = c.resolve(path);
     if !full.is_file() {
         return c.file_exists(key, path);
