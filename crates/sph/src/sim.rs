@@ -417,6 +417,9 @@ impl Simulation {
         }
         self.prepare_sets_with(comm);
         let st = self.passes(0.0);
+        // The wet flags of the start (weight 0: no wet time yet), so that a map or a series row at t = 0
+        // shows the wetting of the liquid at rest rather than all walls dry.
+        self.accumulate_wetting(0.0);
         let n = self.fluid.len();
         self.fluid.acc[..n].copy_from_slice(&self.work.acc_new[..n]);
         self.fluid.drho[..n].copy_from_slice(&self.work.drho_new[..n]);

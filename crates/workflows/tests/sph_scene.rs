@@ -740,8 +740,6 @@ fn a_checkpoint_resumes_on_another_rank_count_with_repartition() {
 /// within 2 dp for the corners), and at every map time the wet squares add up to the wet area the series
 /// reports at that moment (the same wet flags, exactly).
 #[test]
-#[ignore = "known defect: a map at t = 0 is written before the first step sets the wall's wet flags, so it \
-            shows no wetting (docs/sph.md, instantaneous maps)"]
 fn instantaneous_maps_show_the_wetting_of_their_moment() {
     let text = SMALL
         .replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwetting_map_times_s = [0.0, 0.05]");

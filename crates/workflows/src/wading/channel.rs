@@ -120,30 +120,56 @@ impl ChannelSpec {
     /// highest centre of a circle of radius r touching the profile from above (on a ramp the contact
     /// point moves up the slope; over a kink the wheel rests on the kink).
     pub fn axle_z(&self, x: f64, r: f64) -> f64 {
-        let p = self.profile();
-        let mut z = f64::NEG_INFINITY;
-        // Tangent to a segment (or to the flat road continued beyond the ends).
-        let mut lines: Vec<((f64, f64), (f64, f64))> = p.windows(2).map(|w| (w[0], w[1])).collect();
-        lines.push(((f64::NEG_INFINITY, p[0].1), p[0]));
-        lines.push((p[5], (f64::INFINITY, p[5].1)));
-        for ((x0, z0), (x1, z1)) in lines {
-            let s = if x1.is_finite() && x0.is_finite() && x1 > x0 { (z1 - z0) / (x1 - x0) } else { 0.0 };
-            let k = (1.0 + s * s).sqrt();
-            let xt = x + s * r / k;
-            if xt >= x0 && xt <= x1 {
-                let zl = if x0.is_finite() { z0 + s * (x - x0) } else { z1 };
-                z = z.max(zl + r * k);
-            }
-        }
-        // Resting on a convex kink.
-        for (xv, zv) in p {
-            let dx = xv - x;
-            if dx.abs() <= r {
-                z = z.max(zv + (r * r - dx * dx).sqrt());
-            }
-        }
-        z
+        axle_z_on(&self.profile(), x, r)
     }
+}
+
+/// A road the wheels roll on: the generated channel or one read from an STL file.
+pub trait Road {
+    /// Height \[m\] of the axle of a wheel of radius `r` \[m\] resting on the road with its axle over
+    /// `(x, y)` and its wheel plane along `heading` \[rad from +x towards +y\].
+    fn axle_height(&self, x: f64, y: f64, r: f64, heading: f64) -> f64;
+}
+
+impl Road for ChannelSpec {
+    /// The profile does not change across the channel (`y` plays no part); seen along a heading ψ its
+    /// break points are 1/cos ψ further apart (a ramp of slope s looks like one of slope s cos ψ).
+    fn axle_height(&self, x: f64, _y: f64, r: f64, heading: f64) -> f64 {
+        if heading == 0.0 {
+            return self.axle_z(x, r);
+        }
+        let c = heading.cos().abs().max(1e-6);
+        let p = self.profile().map(|(xk, zk)| (x + (xk - x) / c, zk));
+        axle_z_on(&p, x, r)
+    }
+}
+
+/// [`ChannelSpec::axle_z`] on the piecewise linear profile `p` (break points `(x, z)`, x increasing,
+/// flat beyond the ends).
+fn axle_z_on(p: &[(f64, f64); 6], x: f64, r: f64) -> f64 {
+    let p = *p;
+    let mut z = f64::NEG_INFINITY;
+    // Tangent to a segment (or to the flat road continued beyond the ends).
+    let mut lines: Vec<((f64, f64), (f64, f64))> = p.windows(2).map(|w| (w[0], w[1])).collect();
+    lines.push(((f64::NEG_INFINITY, p[0].1), p[0]));
+    lines.push((p[5], (f64::INFINITY, p[5].1)));
+    for ((x0, z0), (x1, z1)) in lines {
+        let s = if x1.is_finite() && x0.is_finite() && x1 > x0 { (z1 - z0) / (x1 - x0) } else { 0.0 };
+        let k = (1.0 + s * s).sqrt();
+        let xt = x + s * r / k;
+        if xt >= x0 && xt <= x1 {
+            let zl = if x0.is_finite() { z0 + s * (x - x0) } else { z1 };
+            z = z.max(zl + r * k);
+        }
+    }
+    // Resting on a convex kink.
+    for (xv, zv) in p {
+        let dx = xv - x;
+        if dx.abs() <= r {
+            z = z.max(zv + (r * r - dx * dx).sqrt());
+        }
+    }
+    z
 }
 
 /// `n = ⌊(hi − lo)/dp⌋` lattice coordinates spaced `dp`, centred in `[lo, hi]`: a fill symmetric about the

@@ -67,7 +67,8 @@ pub struct VehicleConfig {
     pub start_gap_m: f64,
 }
 
-/// How the vehicle moves along the channel: a constant speed or a speed table (exactly one).
+/// How the vehicle moves: a constant speed or a speed table along the channel, or a free path (exactly
+/// one).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MotionSpec {
@@ -77,6 +78,21 @@ pub struct MotionSpec {
     /// Speed table: rows `t_s speed_m_s`, linearly interpolated, held beyond the ends.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub file: Option<PathBuf>,
+    /// A free path of the front axle (`[motion.path]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathSpec>,
+}
+
+/// A path `t x y [z]` of the front axle's centre-line point, from a file or inline (exactly one).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    /// File of rows `t_s x_m y_m [z_m]` (whitespace or commas, `#` comments, an optional header line).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Rows `[t_s, x_m, y_m]` or `[t_s, x_m, y_m, z_m]` given inline.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rows: Option<Vec<Vec<f64>>>,
 }
 
 /// What is written and when the run ends.
@@ -157,13 +173,24 @@ impl Validate for WadingConfig {
             c.non_negative("adhesion", self.vehicle.adhesion);
             c.non_negative("start_gap_m", self.vehicle.start_gap_m);
         });
-        c.nested("motion", |c| match (self.motion.speed_m_s, &self.motion.file) {
-            (Some(v), None) => c.positive("speed_m_s", v),
-            (None, Some(f)) => c.file_exists("file", f),
+        c.nested("motion", |c| {
+            match (self.motion.speed_m_s, &self.motion.file, &self.motion.path) {
+            (Some(v), None, None) => c.positive("speed_m_s", v),
+            (None, Some(f), None) => c.file_exists("file", f),
+            (None, None, Some(p)) => c.nested("path", |c| match (&p.file, &p.rows) {
+                (Some(f), None) => c.file_exists("file", f),
+                (None, Some(_)) => {}
+                _ => c.fail(
+                    "file",
+                    "give exactly one of file (rows `t_s x_m y_m [z_m]`) and rows ([[t, x, y], …] inline)",
+                ),
+            }),
             _ => c.fail(
                 "speed_m_s",
-                "give exactly one of speed_m_s (constant speed, m/s) and file (a table of `t_s speed_m_s` rows)",
+                "give exactly one of speed_m_s (constant speed, m/s), file (a table of `t_s speed_m_s` rows) \
+                 and [motion.path] (rows `t_s x_m y_m [z_m]` of the front axle)",
             ),
+        }
         });
         c.nested("output", |c| {
             let o = &self.output;

@@ -14,6 +14,7 @@ pub mod config;
 pub mod geometry;
 pub mod parts;
 pub mod patches;
+pub mod path;
 pub mod run;
 pub mod timeline;
 pub mod vehicle;

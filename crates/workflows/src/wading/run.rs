@@ -2,11 +2,12 @@
 //! they make (channel, pool, moving parts, splash-height sensors), then the wading reports (sensor
 //! series, wetting per group, the study's scalars).
 
-use super::channel::ChannelSpec;
+use super::channel::{ChannelSpec, Road};
 use super::config::WadingConfig;
 use super::geometry::{road_mesh, side_walls_mesh, write_stl};
 use super::parts::{bounds, read_parts, NamedPart};
-use super::timeline::SpeedProfile;
+use super::path::VehiclePath;
+use super::timeline::{SpeedProfile, Travel};
 use super::vehicle::{check_wheels, check_width, place_on_road, Placement, WheelSpec};
 use crate::sph_scene::config::{
     DomainConfig, FillConfig, FillType, HeightConfig, MotionConfig, MotionType, OutputConfig, SensorConfig,
@@ -46,7 +47,8 @@ pub struct Plan {
     pub parts: Vec<NamedPart>,
     /// Report group of each part.
     pub groups: Vec<String>,
-    pub speed: SpeedProfile,
+    /// The front axle's way over time.
+    pub travel: Travel,
     /// Front axle's x at t = 0 \[m\].
     pub x_front0: f64,
     /// When the front wheels' leading edge reaches the still water \[s\].
@@ -113,35 +115,53 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
     if let Some(e) = check_width(&parts, &cfg.channel) {
         return Err(input(&e.key, e.message));
     }
-    let speed = match (&cfg.motion.speed_m_s, &cfg.motion.file) {
-        (Some(v), _) => SpeedProfile::constant(*v),
-        (None, Some(f)) => {
-            let text = std::fs::read_to_string(f)
-                .map_err(|e| input("motion.file", format!("{}: {e}", f.display())))?;
-            SpeedProfile::parse(&text, f).map_err(|e| input("motion.file", e))?
-        }
-        (None, None) => return Err(input("motion.speed_m_s", "give speed_m_s or file")),
-    };
     let front = front_wheel(&cfg.vehicle.wheels);
     let r_front = front.map(|w| w.radius_m).unwrap_or(0.0);
     let (x_in, _) = cfg.channel.waterline();
-    let x_front0 = x_in - r_front - cfg.vehicle.start_gap_m;
-    let t_enter = speed.time_to(x_in - r_front - x_front0).unwrap_or(0.0);
+    let along = |speed| Travel::Along { x0: x_in - r_front - cfg.vehicle.start_gap_m, speed };
+    let m = &cfg.motion;
+    let travel = match (&m.speed_m_s, &m.file, &m.path) {
+        (Some(v), _, _) => along(SpeedProfile::constant(*v)),
+        (None, Some(f), _) => {
+            let text = std::fs::read_to_string(f)
+                .map_err(|e| input("motion.file", format!("{}: {e}", f.display())))?;
+            along(SpeedProfile::parse(&text, f).map_err(|e| input("motion.file", e))?)
+        }
+        (None, None, Some(p)) => Travel::Path(read_path(p)?),
+        (None, None, None) => return Err(input("motion.speed_m_s", "give speed_m_s, file or [motion.path]")),
+    };
+    let on_path = matches!(travel, Travel::Path(_));
+    let x_front0 = travel.front(0.0).0;
+    let t_enter = travel.time_to_x(x_in - r_front).unwrap_or(0.0);
     let t_end = match cfg.output.end_time_s {
         Some(t) => t,
-        None => speed.time_to(cfg.channel.pool_end_x() - x_front0).ok_or_else(|| {
-            input(
-                "motion.file",
-                "the speed table comes to rest before the front wheels reach the end of the pool; give \
-                 output.end_time_s or a table that keeps moving",
-            )
+        None => travel.time_to_x(cfg.channel.pool_end_x()).ok_or_else(|| {
+            if on_path {
+                input(
+                    "motion.path",
+                    format!(
+                        "the path's front axle never reaches the end of the pool floor (x = {} m); give \
+                         output.end_time_s or a path that gets there",
+                        cfg.channel.pool_end_x()
+                    ),
+                )
+            } else {
+                input(
+                    "motion.file",
+                    "the speed table comes to rest before the front wheels reach the end of the pool; give \
+                     output.end_time_s or a table that keeps moving",
+                )
+            }
         })?,
     };
+    if let Travel::Path(p) = &travel {
+        check_path(cfg, &parts, p, &travel, t_end)?;
+    }
     let mut map_times = Vec::new();
     for (i, x) in cfg.output.map_positions_m.iter().enumerate() {
-        let x_end = x_front0 + speed.distance(t_end);
+        let x_end = travel.front(t_end).0;
         // The end itself is a valid position (its time may come out a rounding error beyond the end).
-        match speed.time_to(x - x_front0).filter(|t| *x >= x_front0 && *t <= t_end * (1.0 + 1e-9)) {
+        match travel.time_to_x(*x).filter(|t| *x >= x_front0 && *t <= t_end * (1.0 + 1e-9)) {
             Some(t) => map_times.push(t.min(t_end)),
             None => {
                 return Err(input(
@@ -155,7 +175,111 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
     }
     let mut sensors = cfg.sensors.clone();
     sensors.extend(cfg.sensor_boxes.iter().map(|b| b.name.clone()));
-    Ok(Plan { parts, groups, speed, x_front0, t_enter, t_end, r_front, sensors, map_times })
+    Ok(Plan { parts, groups, travel, x_front0, t_enter, t_end, r_front, sensors, map_times })
+}
+
+/// The path of `[motion.path]`, read from its file or its rows; errors under `motion.path.file` (with
+/// the file's line) or `motion.path.rows`.
+fn read_path(p: &super::config::PathSpec) -> Result<VehiclePath, WadingError> {
+    match (&p.file, &p.rows) {
+        (Some(f), None) => {
+            let text = std::fs::read_to_string(f)
+                .map_err(|e| input("motion.path.file", format!("{}: {e}", f.display())))?;
+            VehiclePath::parse(&text, f).map_err(|e| input("motion.path.file", e))
+        }
+        (None, Some(rows)) => VehiclePath::from_rows(rows).map_err(|e| input("motion.path", e)),
+        _ => Err(input("motion.path.file", "give exactly one of file and rows")),
+    }
+}
+
+/// Relative tolerance of a path row's height against the height the road carries the front axle at.
+pub const PATH_Z_TOLERANCE: f64 = 0.05;
+
+/// A path's heights agree with the road (within [`PATH_Z_TOLERANCE`] of the front wheel's radius), and
+/// the vehicle stays inside the channel all the way: the corners of its parts' bounding box, placed on
+/// the road, between the side walls and over the channel's length, sampled every 2 cm of travel.
+fn check_path(
+    cfg: &WadingConfig,
+    parts: &[NamedPart],
+    path: &VehiclePath,
+    travel: &Travel,
+    t_end: f64,
+) -> Result<(), WadingError> {
+    let c = &cfg.channel;
+    let wheels = &cfg.vehicle.wheels;
+    let r_front = front_wheel(wheels).map(|w| w.radius_m).unwrap_or(0.0);
+    let key = || if path.origin_at(0.0).starts_with("rows[") { "motion.path" } else { "motion.path.file" };
+    for h in &path.heights {
+        let (x, y) = travel.front(h.t);
+        let z = c.axle_height(x, y, r_front, travel.heading(h.t));
+        if (h.z - z).abs() > PATH_Z_TOLERANCE * r_front {
+            return Err(input(
+                key(),
+                format!(
+                    "{}: z = {} m, but the road carries the front axle at z = {z:.4} m there (x = {x:.3} m, \
+                     y = {y:.3} m): the wheels roll on the road; give its height within {} m ({} % of the wheel \
+                     radius) or leave z out",
+                    h.origin,
+                    h.z,
+                    PATH_Z_TOLERANCE * r_front,
+                    PATH_Z_TOLERANCE * 100.0
+                ),
+            ));
+        }
+    }
+    let b = bounds(parts);
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| {
+            Vec3::new(
+                if k & 1 == 0 { b.min.x } else { b.max.x },
+                if k & 2 == 0 { b.min.y } else { b.max.y },
+                if k & 4 == 0 { b.min.z } else { b.max.z },
+            )
+        })
+        .collect();
+    let (half, length) = (0.5 * c.width_m, c.length());
+    let dt = (0.02 / travel.max_speed().max(1e-9)).min(0.01);
+    let n = (t_end / dt).ceil() as usize;
+    for k in 0..=n {
+        let t = (k as f64 * dt).min(t_end);
+        let heading = travel.heading(t);
+        if heading.cos() < 0.2 {
+            return Err(input(
+                key(),
+                format!(
+                    "at t = {t:.3} s (after {}) the path heads {:.1}° off the channel's axis (+x); the vehicle \
+                     drives along the channel, within 78° of +x",
+                    path.origin_at(t),
+                    heading.to_degrees()
+                ),
+            ));
+        }
+        let p = place_on_road(parts, wheels, c, travel.front(t), heading);
+        for q in corners.iter().map(|&q| p.apply(q)) {
+            let beyond = if q.y.abs() > half {
+                Some(format!(
+                    "y = {:.3} m, beyond the side wall at y = {}{half} m",
+                    q.y,
+                    if q.y > 0.0 { "+" } else { "-" }
+                ))
+            } else if q.x < 0.0 || q.x > length {
+                Some(format!("x = {:.3} m, beyond the channel's ends (x from 0 to {length} m)", q.x))
+            } else {
+                None
+            };
+            if let Some(what) = beyond {
+                return Err(input(
+                    key(),
+                    format!(
+                        "at t = {t:.3} s (after {}) the vehicle leaves the channel: a corner of its parts reaches \
+                         {what}; keep the path inside the channel",
+                        path.origin_at(t)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
@@ -167,32 +291,50 @@ fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
 /// central differences of the placement on the road.
 fn body_table(plan: &Plan, place: &dyn Fn(f64) -> Placement, dt: f64) -> String {
     let pose = |t: f64| {
-        let p = place(plan.x_front0 + plan.speed.distance(t));
-        (p.pivot + p.shift, p.pitch)
+        let p = place(t);
+        (p.pivot + p.shift, p.pitch, p.yaw)
     };
     let n = (plan.t_end / dt).ceil() as usize + 1;
     let eps = 1e-4 * dt;
     let mut s = String::from("# t_s vx vy vz wx wy wz: the vehicle body about its rear axle\n");
     for k in 0..=n {
         let t = k as f64 * dt;
-        let (p1, a1) = pose(t + eps);
-        let (p0, a0) = pose((t - eps).max(0.0));
+        let (p1, a1, y1) = pose(t + eps);
+        let (p0, a0, y0) = pose((t - eps).max(0.0));
         let h = t + eps - (t - eps).max(0.0);
         let v = (p1 - p0) / h;
-        // Nose up (pitch growing) is a rotation about −y.
-        let wy = -(a1 - a0) / h;
-        let _ = writeln!(s, "{t} {} {} {} 0 {wy} 0", v.x, v.y, v.z);
+        // Nose up (pitch growing) is a rotation about the body's −y axis, which the heading ψ has turned
+        // to (sin ψ, −cos ψ, 0); the heading turns about +z. (`+ 0.0` writes a zero as `0`, not `-0`.)
+        let pitch_rate = (a1 - a0) / h;
+        let yaw_rate = wrap_angle(y1 - y0) / h;
+        let (sin_h, cos_h) = (0.5 * (y0 + y1)).sin_cos();
+        let (wx, wy, wz) = (sin_h * pitch_rate + 0.0, -(cos_h * pitch_rate), yaw_rate + 0.0);
+        let _ = writeln!(s, "{t} {} {} {} {wx} {wy} {wz}", v.x, v.y, v.z);
     }
     s
 }
 
-/// Rows of a wheel's spin relative to the body: ω_y = v(t)/R (rolling without slip along +x).
+/// Angle `a` \[rad\] brought into (−π, π].
+fn wrap_angle(a: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if a > PI || a <= -PI {
+        a - TAU * ((a + PI) / TAU).floor()
+    } else {
+        a
+    }
+}
+
+/// Rows of a wheel's spin relative to the body: ω = v(t)/R about the axle (rolling without slip), the
+/// axle along the body's y axis as it was at t = 0 (heading ψ₀: (−sin ψ₀, cos ψ₀, 0)), the frame the body
+/// carries its wheels' tables in.
 fn wheel_table(plan: &Plan, radius: f64, dt: f64) -> String {
     let n = (plan.t_end / dt).ceil() as usize + 1;
+    let (sin0, cos0) = plan.travel.heading(0.0).sin_cos();
     let mut s = String::from("# t_s vx vy vz wx wy wz: wheel spin relative to the body, omega = v/R\n");
     for k in 0..=n {
         let t = k as f64 * dt;
-        let _ = writeln!(s, "{t} 0 0 0 0 {} 0", plan.speed.speed(t) / radius);
+        let w = plan.travel.speed(t) / radius;
+        let _ = writeln!(s, "{t} 0 0 0 {} {} 0", -(sin0 * w) + 0.0, cos0 * w);
     }
     s
 }
@@ -209,11 +351,11 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
     let c: &ChannelSpec = &cfg.channel;
     let dp = cfg.fluid.spacing_m;
     let wheels = &cfg.vehicle.wheels;
-    let place = |x_front: f64| place_on_road(&plan.parts, wheels, c, x_front);
-    let p0 = place(plan.x_front0);
+    let place = |t: f64| place_on_road(&plan.parts, wheels, c, plan.travel.front(t), plan.travel.heading(t));
+    let p0 = place(0.0);
     let pivot0 = p0.pivot + p0.shift;
     // Motion tables sampled every 2 cm of travel (at most 10 ms).
-    let dt = (0.02 / plan.speed.max_speed().max(1e-9)).min(0.01);
+    let dt = (0.02 / plan.travel.max_speed().max(1e-9)).min(0.01);
     let body_file = geo.join("motion_body.txt");
     write_text(&body_file, &body_table(plan, &place, dt))?;
     let mut motions = vec![MotionConfig {
@@ -367,7 +509,7 @@ pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingErr
         plan.x_front0,
         plan.t_enter,
         plan.t_end,
-        plan.x_front0 + plan.speed.distance(plan.t_end)
+        plan.travel.front(plan.t_end).0
     );
     let mut summary = crate::sph_scene::run(&scfg, ctx)?;
     if summary.finished != Finished::Completed {
@@ -543,7 +685,7 @@ fn report(
         format!(
             "wading: front axle from x = {:.3} m to {:.3} m (pool end {:.3} m), water depth {} m",
             plan.x_front0,
-            plan.x_front0 + plan.speed.distance(plan.t_end),
+            plan.travel.front(plan.t_end).0,
             cfg.channel.pool_end_x(),
             cfg.channel.water_depth_m
         ),
@@ -554,7 +696,7 @@ fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wading::config::{MotionSpec, WadingOutput};
+    use crate::wading::config::{MotionSpec, PathSpec, WadingOutput};
     use crate::wading::patches::SensorBox;
     use crate::wading::vehicle::PartFile;
     use spatter_core::mesh::TriMesh;
@@ -627,7 +769,7 @@ mod tests {
         let body = &scene.motions[0];
         let text = std::fs::read_to_string(body.file.as_ref().unwrap()).unwrap();
         let motion = Motion::Tabulated(MotionTable::parse(&text, body.reference_point_m.unwrap()).unwrap());
-        let p0 = place_on_road(&plan.parts, &cfg.vehicle.wheels, c, plan.x_front0);
+        let p0 = place_on_road(&plan.parts, &cfg.vehicle.wheels, c, (plan.x_front0, 0.0), 0.0);
         let front0 = p0.apply(Vec3::new(3.0, 0.8, 2.4));
         let rear0 = p0.apply(Vec3::new(0.0, 0.8, 2.4));
         // At x = 4.2 the front wheel already rests on the entry ramp (it starts at x = 4).
@@ -700,6 +842,195 @@ mod tests {
         assert!(e.starts_with("sensor_boxes[0].part: part = \"fl\" is a wheel"), "{e}");
     }
 
+    /// Rows `t v ω` of a motion table's text.
+    fn table_rows(path: &Path) -> Vec<Vec<f64>> {
+        let text = std::fs::read_to_string(path).unwrap();
+        text.lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+            .collect()
+    }
+
+    /// A straight path along the centre line at 2 m/s (two rows) moves the vehicle as `speed_m_s = 2`
+    /// does: the same placement at t = 0 (to 1e-12 m) and the same motion tables, row for row (times to
+    /// 1e-12 s: the sampling step 2 cm / v_max takes v_max from the path's samples), to 1e-7 m/s and
+    /// rad/s. (The tables differentiate the placement over 2·10⁻⁶ s, so position round-off of
+    /// 10⁻¹⁵ m — the path's cubic evaluated on a line — shows as up to 10⁻⁹ m/s.)
+    #[test]
+    fn a_straight_path_moves_the_vehicle_as_the_speed_does() {
+        let dir = tempfile::tempdir().unwrap();
+        let cfg = config(dir.path());
+        let by_speed = plan(&cfg).unwrap();
+        let geo_speed = dir.path().join("by_speed");
+        let scene_speed = scene(&cfg, &by_speed, &geo_speed).unwrap();
+        let mut on_path = cfg.clone();
+        let (x0, t1) = (by_speed.x_front0, by_speed.t_end + 1.0);
+        on_path.motion = MotionSpec {
+            speed_m_s: None,
+            file: None,
+            path: Some(PathSpec {
+                file: None,
+                rows: Some(vec![vec![0.0, x0, 0.0], vec![t1, x0 + 2.0 * t1, 0.0]]),
+            }),
+        };
+        let by_path = plan(&on_path).unwrap();
+        assert!((by_path.t_end - by_speed.t_end).abs() < 1e-9, "{} vs {}", by_path.t_end, by_speed.t_end);
+        assert!((by_path.t_enter - by_speed.t_enter).abs() < 1e-9);
+        on_path.output.end_time_s = Some(by_speed.t_end);
+        let by_path = plan(&on_path).unwrap();
+        let geo_path = dir.path().join("by_path");
+        let scene_path = scene(&on_path, &by_path, &geo_path).unwrap();
+        for (a, b) in scene_speed.motions.iter().zip(&scene_path.motions) {
+            let (ra, rb) = (a.reference_point_m.unwrap(), b.reference_point_m.unwrap());
+            assert!((ra - rb).length() < 1e-12, "{}: reference point {ra} vs {rb}", a.name);
+            let (ta, tb) = (table_rows(a.file.as_ref().unwrap()), table_rows(b.file.as_ref().unwrap()));
+            assert_eq!(ta.len(), tb.len(), "{}", a.name);
+            for (x, y) in ta.iter().zip(&tb) {
+                assert!((x[0] - y[0]).abs() < 1e-12, "{}: times {} vs {}", a.name, x[0], y[0]);
+                for j in 1..7 {
+                    assert!(
+                        (x[j] - y[j]).abs() < 1e-7,
+                        "{} at t = {}: column {j}: {} vs {}",
+                        a.name,
+                        x[0],
+                        x[j],
+                        y[j]
+                    );
+                }
+            }
+        }
+        for part in ["fl", "rr"] {
+            let a = TriMesh::load(&geo_speed.join(format!("{part}.stl")), 1.0).unwrap();
+            let b = TriMesh::load(&geo_path.join(format!("{part}.stl")), 1.0).unwrap();
+            for (u, v) in a.vertices.iter().zip(&b.vertices) {
+                assert!((*u - *v).length() < 1e-12, "{part}: {u} vs {v}");
+            }
+        }
+    }
+
+    /// The vehicle on an arc of radius 30 m at 2 m/s (ω = 1/15 rad/s, rows every 0.25 s over 3 s): the
+    /// integrated body motion keeps the front axle on the path (to 3 mm, the motion table's integration)
+    /// and turns the body with the path's tangent ω t (to 2 mrad), both axles on the road; each wheel
+    /// spins about the body's lateral axis at v/R (to 10⁻⁴: the table samples the speed every 2 cm).
+    #[test]
+    fn a_curved_path_turns_the_vehicle_with_its_tangent() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = config(dir.path());
+        let x0 = plan(&cfg).unwrap().x_front0;
+        let (r, w) = (30.0, 2.0 / 30.0);
+        let rows: Vec<Vec<f64>> = (0..=12)
+            .map(|k| {
+                let t = 0.25 * k as f64;
+                vec![t, x0 + r * (w * t).sin(), -0.3 + r * (1.0 - (w * t).cos())]
+            })
+            .collect();
+        cfg.motion =
+            MotionSpec { speed_m_s: None, file: None, path: Some(PathSpec { file: None, rows: Some(rows) }) };
+        cfg.output.end_time_s = Some(3.0);
+        let plan = plan(&cfg).unwrap();
+        let scene = scene(&cfg, &plan, &dir.path().join("geometry")).unwrap();
+        let c = &cfg.channel;
+        let load = |k: usize| {
+            let m = &scene.motions[k];
+            let text = std::fs::read_to_string(m.file.as_ref().unwrap()).unwrap();
+            Motion::Tabulated(MotionTable::parse(&text, m.reference_point_m.unwrap()).unwrap())
+        };
+        let mut tree = spatter_core::motion::KinematicTree::new();
+        let body = tree.add(load(0), None);
+        let spin = tree.add(load(1), Some(body));
+        let p0 = place_on_road(
+            &plan.parts,
+            &cfg.vehicle.wheels,
+            c,
+            plan.travel.front(0.0),
+            plan.travel.heading(0.0),
+        );
+        let front0 = p0.apply(Vec3::new(3.0, 0.0, 2.4));
+        let rear0 = p0.apply(Vec3::new(0.0, 0.0, 2.4));
+        let axle0 = p0.apply(Vec3::new(3.0, 1.0, 2.4)) - p0.apply(Vec3::new(3.0, 0.0, 2.4));
+        for k in 0..30 {
+            let t = 0.1 * k as f64;
+            let f = tree.world_point(body, t, front0);
+            let rr = tree.world_point(body, t, rear0);
+            let (xp, yp) = (x0 + r * (w * t).sin(), -0.3 + r * (1.0 - (w * t).cos()));
+            assert!((f.x - xp).hypot(f.y - yp) < 3e-3, "t = {t}: front axle {f} off the path ({xp}, {yp})");
+            assert!((f.z - c.axle_z(f.x, 0.4)).abs() < 3e-3, "t = {t}: front axle {f} off the road");
+            assert!((rr.z - c.axle_z(rr.x, 0.4)).abs() < 3e-3, "t = {t}: rear axle {rr} off the road");
+            let fwd = f - rr;
+            let heading = fwd.y.atan2(fwd.x);
+            assert!((heading - w * t).abs() < 2e-3, "t = {t}: body heading {heading} vs tangent {}", w * t);
+            // The wheel's own spin (its angular velocity less the body's) lies along the body's axle.
+            let rel = tree.angular_velocity(spin, t) - tree.angular_velocity(body, t);
+            let axle = tree.rotation(body, t) * axle0;
+            assert!(rel.cross(axle).length() < 1e-9 * rel.length(), "t = {t}: spin {rel} not along {axle}");
+            assert!(
+                (rel.length() - plan.travel.speed(t) / 0.4).abs() < 1e-4 * 5.0,
+                "t = {t}: ω = {}",
+                rel.length()
+            );
+            assert!((plan.travel.speed(t) - 2.0).abs() < 0.01);
+        }
+    }
+
+    /// A path that leaves the channel, a row height off the road, a garbled file and one row are named
+    /// by key, file, line and value.
+    #[test]
+    fn bad_paths_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = config(dir.path());
+        let x0 = plan(&cfg).unwrap().x_front0;
+        let path_rows = |rows: Vec<Vec<f64>>| MotionSpec {
+            speed_m_s: None,
+            file: None,
+            path: Some(PathSpec { file: None, rows: Some(rows) }),
+        };
+        cfg.output.end_time_s = Some(2.0);
+        // 0.7 m off the centre line the vehicle (1.8 m wide) reaches beyond the wall at y = 1.5 m.
+        cfg.motion = path_rows(vec![vec![0.0, x0, 0.7], vec![2.0, x0 + 4.0, 0.7]]);
+        let e = plan_err(&cfg);
+        assert!(
+            e.starts_with("motion.path: at t = 0.000 s (after rows[0]) the vehicle leaves the channel"),
+            "{e}"
+        );
+        assert!(e.contains("reaches y = 1.600 m, beyond the side wall at y = +1.5 m"), "{e}");
+        // Heights: on the flat approach the front axle rides at R = 0.4 m.
+        cfg.motion = path_rows(vec![vec![0.0, x0 - 1.0, 0.0, 0.4], vec![2.0, x0 + 3.0, 0.0, 0.9]]);
+        let e = plan_err(&cfg);
+        assert!(
+            e.starts_with("motion.path: rows[1]: z = 0.9 m, but the road carries the front axle at z = "),
+            "{e}"
+        );
+        let f = dir.path().join("path.csv");
+        std::fs::write(&f, "t_s,x_m,y_m\n0,4.2,0\n1,6.2,zero\n").unwrap();
+        cfg.motion = MotionSpec {
+            speed_m_s: None,
+            file: None,
+            path: Some(PathSpec { file: Some(f.clone()), rows: None }),
+        };
+        let e = plan_err(&cfg);
+        assert!(
+            e.starts_with("motion.path.file: ") && e.contains("path.csv line 3: `zero` is not a number"),
+            "{e}"
+        );
+        std::fs::write(&f, "0 4.2 0\n").unwrap();
+        let e = plan_err(&cfg);
+        assert!(e.contains("path.csv: 1 row(s); a path needs at least two rows"), "{e}");
+        std::fs::write(&f, "0 4.2 0\n1 4.0 0\n").unwrap();
+        cfg.output.end_time_s = None;
+        let e = plan_err(&cfg);
+        assert!(
+            e.starts_with("motion.path: the path's front axle never reaches the end of the pool floor"),
+            "{e}"
+        );
+        let mut both = cfg.clone();
+        both.motion.speed_m_s = Some(2.0);
+        let errs = spatter_core::check::Checker::run(&both, None).unwrap_err();
+        assert!(
+            errs.iter().any(|e| e.key == "motion.speed_m_s" && e.message.contains("exactly one")),
+            "{errs:?}"
+        );
+    }
+
     fn plan_err(cfg: &WadingConfig) -> String {
         plan(cfg).err().unwrap().to_string()
     }
@@ -717,7 +1048,7 @@ mod tests {
         cfg.sensors.clear();
         let table = dir.path().join("v.txt");
         std::fs::write(&table, "0 2\n1 0\n").unwrap();
-        cfg.motion = MotionSpec { speed_m_s: None, file: Some(table) };
+        cfg.motion = MotionSpec { speed_m_s: None, file: Some(table), path: None };
         let e = plan(&cfg).err().unwrap().to_string();
         assert!(e.starts_with("motion.file: the speed table comes to rest"), "{e}");
         cfg.vehicle.wheels[0].part = "front".into();

@@ -1,6 +1,58 @@
-//! The vehicle's progress along the channel over time: a constant speed or a speed table.
+//! The vehicle's progress over time: a constant speed or a speed table along the channel, or a free path.
 
+use super::path::VehiclePath;
 use std::path::Path;
+
+/// Where the front axle's centre-line point is over time \[m, s\], its heading and its speed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Travel {
+    /// Along +x from `x0` on the channel's centre line (y = 0, heading 0) at a speed over time.
+    Along { x0: f64, speed: SpeedProfile },
+    /// A free path `t x y [z]`.
+    Path(VehiclePath),
+}
+
+impl Travel {
+    /// Front axle's centre-line point `(x, y)` at `t` \[m\].
+    pub fn front(&self, t: f64) -> (f64, f64) {
+        match self {
+            Travel::Along { x0, speed } => (x0 + speed.distance(t), 0.0),
+            Travel::Path(p) => p.point(t),
+        }
+    }
+
+    /// Heading at `t` \[rad from +x towards +y\].
+    pub fn heading(&self, t: f64) -> f64 {
+        match self {
+            Travel::Along { .. } => 0.0,
+            Travel::Path(p) => p.heading(t),
+        }
+    }
+
+    /// Speed over the ground at `t` \[m/s\] (horizontal), which turns the wheels at ω = v/R.
+    pub fn speed(&self, t: f64) -> f64 {
+        match self {
+            Travel::Along { speed, .. } => speed.speed(t),
+            Travel::Path(p) => p.speed(t),
+        }
+    }
+
+    /// Largest speed \[m/s\].
+    pub fn max_speed(&self) -> f64 {
+        match self {
+            Travel::Along { speed, .. } => speed.max_speed(),
+            Travel::Path(p) => p.max_speed(),
+        }
+    }
+
+    /// First time the front axle reaches `x` \[m\] or beyond, `None` if never.
+    pub fn time_to_x(&self, x: f64) -> Option<f64> {
+        match self {
+            Travel::Along { x0, speed } => speed.time_to(x - x0),
+            Travel::Path(p) => p.time_to_x(x),
+        }
+    }
+}
 
 /// Vehicle speed over time \[m/s\]: rows `(t, v)` linearly interpolated and held beyond the ends; the
 /// distance travelled is the exact integral of that piecewise linear speed.

@@ -1,7 +1,7 @@
 //! The vehicle: its part files, its wheels (found by part name, with axle and radius), checks that name
 //! the scenario key of every problem, and its placement on the channel's road.
 
-use super::channel::{pitch, ChannelSpec};
+use super::channel::{pitch, ChannelSpec, Road};
 use super::parts::{bounds, wheel_reach, NamedPart};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Invalid;
@@ -111,10 +111,12 @@ pub fn check_width(parts: &[NamedPart], channel: &ChannelSpec) -> Option<Invalid
 }
 
 /// Rigid placement of the vehicle on the road: rotate by `pitch` \[rad\] (nose up positive) about the
-/// rear axle, then translate by `shift` \[m\].
+/// rear axle, then turn by `yaw` \[rad\] (the heading, from +x towards +y) about the vertical through it,
+/// then translate by `shift` \[m\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
     pub pitch: f64,
+    pub yaw: f64,
     pub pivot: Vec3,
     pub shift: Vec3,
 }
@@ -125,34 +127,49 @@ impl Placement {
         let d = x - self.pivot;
         // Nose up for travel along +x: a rotation by −pitch about +y.
         let (s, c) = (-self.pitch).sin_cos();
-        let r = Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+        let mut r = Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+        if self.yaw != 0.0 {
+            let (s, c) = self.yaw.sin_cos();
+            r = Vec3::new(c * r.x - s * r.y, s * r.x + c * r.y, r.z);
+        }
         self.pivot + r + self.shift
     }
 }
 
-/// Places the vehicle so that its front axle (the wheels' largest axle x) is at `x_front` along the
-/// channel, centred across it (y of the parts' bounds' middle at 0), with every wheel on the road: the
-/// front and rear axle heights from [`ChannelSpec::axle_z`], the rear axle where the road puts it at the
-/// axle-to-axle distance behind the front one, and the pitch from the two. `wheels` must have passed
-/// [`check_wheels`].
+/// Places the vehicle so that its front axle (the wheels' largest axle x), at the middle of the parts'
+/// extent across, is over `front = (x, y)` with the vehicle heading along `heading` \[rad from +x towards
+/// +y\], every wheel on the road: the front and rear axle heights from [`Road::axle_height`], the rear
+/// axle on the road at the axle-to-axle distance behind the front one along the heading, and the pitch
+/// from the two. `front = (x, 0)` with heading 0 centres the vehicle across the generated channel.
+/// `wheels` must have passed [`check_wheels`]; the heading must be within 90° of +x.
 pub fn place_on_road(
     parts: &[NamedPart],
     wheels: &[WheelSpec],
-    channel: &ChannelSpec,
-    x_front: f64,
+    road: &dyn Road,
+    front_at: (f64, f64),
+    heading: f64,
 ) -> Placement {
     let front = wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
     let rear = wheels.iter().min_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
     let (Some(front), Some(rear)) = (front, rear) else {
-        return Placement { pitch: 0.0, pivot: Vec3::ZERO, shift: Vec3::ZERO };
+        return Placement { pitch: 0.0, yaw: 0.0, pivot: Vec3::ZERO, shift: Vec3::ZERO };
     };
     let b = bounds(parts);
     let y_mid = 0.5 * (b.min.y + b.max.y);
+    let (x_front, y_front) = front_at;
     // Axle-to-axle distance in the x–z plane; the rear axle sits on the road at that distance behind the
-    // front one (bisection: the distance grows as the rear axle moves back).
+    // front one along the heading (bisection on its x: the distance grows as the rear axle moves back).
     let span = ((front.axle_m.x - rear.axle_m.x).powi(2) + (front.axle_m.z - rear.axle_m.z).powi(2)).sqrt();
-    let zf = channel.axle_z(x_front, front.radius_m);
-    let dist = |xr: f64| ((x_front - xr).powi(2) + (zf - channel.axle_z(xr, rear.radius_m)).powi(2)).sqrt();
+    let zf = road.axle_height(x_front, y_front, front.radius_m, heading);
+    let (cos_h, tan_h) = (heading.cos(), heading.tan());
+    let rear_y = |xr: f64| y_front + (xr - x_front) * tan_h;
+    let dist = |xr: f64| {
+        let yr = rear_y(xr);
+        ((x_front - xr).powi(2)
+            + (y_front - yr).powi(2)
+            + (zf - road.axle_height(xr, yr, rear.radius_m, heading)).powi(2))
+        .sqrt()
+    };
     let (mut lo, mut hi) = (x_front - span - 1.0, x_front);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
@@ -163,13 +180,22 @@ pub fn place_on_road(
         }
     }
     let x_rear = 0.5 * (lo + hi);
-    let zr = channel.axle_z(x_rear, rear.radius_m);
-    let th = pitch((x_front, zf), (x_rear, zr))
+    let y_rear = rear_y(x_rear);
+    let zr = road.axle_height(x_rear, y_rear, rear.radius_m, heading);
+    let th = (zf - zr).atan2((x_front - x_rear) / cos_h)
         - pitch((front.axle_m.x, front.axle_m.z), (rear.axle_m.x, rear.axle_m.z));
+    // The pivot (the rear wheel's axle point, `dy` off the centre line) turns with the heading.
+    let dy = rear.axle_m.y - y_mid;
+    let (sin_h, cos_h) = heading.sin_cos();
     Placement {
         pitch: th,
+        yaw: heading,
         pivot: rear.axle_m,
-        shift: Vec3::new(x_rear - rear.axle_m.x, -y_mid, zr - rear.axle_m.z),
+        shift: Vec3::new(
+            x_rear - sin_h * dy - rear.axle_m.x,
+            y_rear - y_mid + (cos_h - 1.0) * dy,
+            zr - rear.axle_m.z,
+        ),
     }
 }
 
@@ -256,12 +282,12 @@ pub(crate) mod tests {
     fn the_vehicle_stands_on_the_road() {
         let (parts, wheels) = truck();
         let c = channel();
-        let p = place_on_road(&parts, &wheels, &c, 6.0);
+        let p = place_on_road(&parts, &wheels, &c, (6.0, 0.0), 0.0);
         assert!(p.pitch.abs() < 1e-12);
         let f = p.apply(wheels[0].axle_m);
         assert!((f - Vec3::new(6.0, 1.0, 0.5)).length() < 1e-12, "{f}");
         for x_front in [9.5, 11.0, 13.0, 20.0, 23.5] {
-            let p = place_on_road(&parts, &wheels, &c, x_front);
+            let p = place_on_road(&parts, &wheels, &c, (x_front, 0.0), 0.0);
             let f = p.apply(wheels[0].axle_m);
             let r = p.apply(wheels[2].axle_m);
             assert!((f.x - x_front).abs() < 1e-9, "front axle at {} not {x_front}", f.x);
