@@ -365,3 +365,41 @@ fn more_ranks_than_particles_is_refused() {
     assert!(errs.iter().all(|e| e == &errs[0]), "{errs:?}");
     assert!(errs[0].contains("4 ranks for 3 particles"), "{}", errs[0]);
 }
+
+/// A run on 2 ranks stopped after 300 steps and continued from each rank's state ([`Simulation::state`]
+/// and [`Simulation::rank_state`], through bincode like a checkpoint) ends bit for bit where the
+/// uninterrupted run ends.
+#[test]
+fn resume_on_the_same_ranks_is_bit_identical() {
+    let (n, first, second) = (150, 300, 300);
+    let out = on_ranks(2, 300, move |comm| {
+        let mut whole = pile(n);
+        for _ in 0..first + second {
+            whole.step_with(comm).unwrap();
+        }
+        let mut part = pile(n);
+        for _ in 0..first {
+            part.step_with(comm).unwrap();
+        }
+        let saved = bincode::serialize(&(part.state(), part.rank_state())).unwrap();
+        drop(part);
+        type Saved = (
+            spatter_dem::sim::SimState<<HertzMindlinRolling as spatter_dem::contact::ContactLaw>::State>,
+            Option<
+                spatter_dem::sim::RankState<<HertzMindlinRolling as spatter_dem::contact::ContactLaw>::State>,
+            >,
+        );
+        let (st, rs): Saved = bincode::deserialize(&saved).unwrap();
+        let mut resumed = pile(n);
+        resumed.restore(st).unwrap();
+        resumed.restore_rank_state(rs.expect("a rank state on 2 ranks"), comm).unwrap();
+        for _ in 0..second {
+            resumed.step_with(comm).unwrap();
+        }
+        let same = format!("{:?}", whole.particles) == format!("{:?}", resumed.particles)
+            && format!("{:?}", whole.energy_with(comm)) == format!("{:?}", resumed.energy_with(comm));
+        (same, whole.particles.len())
+    });
+    assert!(out.iter().all(|o| o.0), "a resumed rank differs: {out:?}");
+    assert!(out.iter().all(|o| o.1 > 0), "every rank holds particles: {out:?}");
+}

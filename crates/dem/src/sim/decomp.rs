@@ -37,6 +37,7 @@ use super::{Integrator, ParticleView, Simulation};
 use crate::contact::{ContactInput, ContactLaw, PairTable};
 use crate::error::DemError;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use spatter_core::comm::{Comm, WireReader, WireWriter};
 use spatter_core::rcb::Rcb;
 use spatter_core::{Aabb, Vec3};
@@ -88,6 +89,15 @@ impl<S> Ghosts<S> {
         self.radius.clear();
         self.inv_mass.clear();
     }
+}
+
+/// What a checkpoint part of a rank keeps of the split ([`Simulation::rank_state`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RankState<S> {
+    /// The split of space over the ranks.
+    pub partition: Rcb,
+    /// Contact states of this rank's particles with ghosts, keyed by the pair's ids (sorted).
+    pub ghost_contacts: Vec<(u64, S)>,
 }
 
 /// This rank's share of a decomposed run.
@@ -241,6 +251,105 @@ impl<L: ContactLaw> Simulation<L> {
             last_migrants: 0,
         });
         Ok(())
+    }
+
+    /// What a checkpoint part keeps of the split besides [`Self::state`] (`None` on one rank): the split
+    /// of space and the contact states with ghosts, keyed by the ids of the pair.
+    pub fn rank_state(&self) -> Option<RankState<L::State>> {
+        let d = self.decomp.as_ref()?;
+        let (g, p) = (&d.ghosts, &self.particles);
+        let default = L::State::default();
+        let mut ghost_contacts = Vec::new();
+        if g.start.len() == p.len() + 1 {
+            for i in 0..p.len() {
+                for k in g.start[i] as usize..g.start[i + 1] as usize {
+                    if g.state[k] != default {
+                        ghost_contacts.push((pair_key(p.id[i], g.id[g.nbr[k] as usize]), g.state[k]));
+                    }
+                }
+            }
+        }
+        ghost_contacts.sort_unstable_by_key(|c| c.0);
+        Some(RankState { partition: d.rcb.clone(), ghost_contacts })
+    }
+
+    /// Continues a rank's state restored by [`Self::restore`] from a checkpoint written on as many
+    /// ranks: takes the split, gets the ghosts (at their current positions) and their contact states
+    /// back. Collective. The run then goes on bit for bit as if it had not stopped: the ghost lists may
+    /// hold other far candidates than before, but every pair within reach, with its state, and in the
+    /// same order.
+    pub fn restore_rank_state(&mut self, rs: RankState<L::State>, comm: &dyn Comm) -> Result<(), DemError> {
+        if rs.partition.ranks() != comm.size() {
+            return Err(DemError::Resume(format!(
+                "the checkpoint was written on {} ranks, this run has {}; a DEM run resumes on as many ranks \
+                 as wrote its checkpoint in this version",
+                rs.partition.ranks(),
+                comm.size()
+            )));
+        }
+        let rank = comm.rank();
+        self.decomp = Some(Decomp {
+            boxes: rs.partition.boxes(),
+            rcb: rs.partition,
+            rank,
+            size: comm.size(),
+            peer_ranks: Vec::new(),
+            send: Vec::new(),
+            ghosts: Ghosts::default(),
+            pending: Default::default(),
+            fresh: false,
+            last_migrants: 0,
+        });
+        let r_max = self.st.r_max;
+        let (range_pp, _) = self.range_max(r_max);
+        let width = 2.0 * r_max + range_pp + self.skin();
+        if let Some(d) = self.decomp.as_mut() {
+            let mut peer_ranks: Vec<usize> = d.rcb.peers(d.rank, width).iter().map(|p| p.rank).collect();
+            peer_ranks.dedup();
+            d.peer_ranks = peer_ranks;
+        }
+        self.exchange_ghosts(comm, width);
+        self.build_ghost_list(range_pp, &rs.ghost_contacts);
+        Ok(())
+    }
+
+    /// Joins the mesh impact records of all ranks (each rank records the contacts of its own particles):
+    /// afterwards rank 0 holds the sums (counts exact, the rest added in rank order) and the other ranks
+    /// zeros, so that rank 0 writes the run's records and the sums over ranks stay right as the run goes
+    /// on. Collective; nothing on one rank.
+    pub fn gather_mesh_records(&mut self, comm: &dyn Comm) {
+        if self.decomp.is_none() {
+            return;
+        }
+        let root = comm.is_root();
+        for w in &mut self.walls {
+            let crate::walls::WallShape::Mesh(m) = &mut w.shape else { continue };
+            let r = &mut m.records;
+            let mut counts = r.impacts.clone();
+            comm.all_sum_u64(&mut counts);
+            r.impacts = counts;
+            for v in [
+                &mut r.normal_impulse,
+                &mut r.tangential_impulse,
+                &mut r.impact_speed_sum,
+                &mut r.impact_angle_sum,
+                &mut r.eroded_mass,
+            ] {
+                comm.sum_f64_ordered(v);
+            }
+            if !root {
+                r.impacts.fill(0);
+                for v in [
+                    &mut r.normal_impulse,
+                    &mut r.tangential_impulse,
+                    &mut r.impact_speed_sum,
+                    &mut r.impact_angle_sum,
+                    &mut r.eroded_mass,
+                ] {
+                    v.fill(0.0);
+                }
+            }
+        }
     }
 
     /// Number of ranks the particles are split over (1 when not split).

@@ -24,6 +24,7 @@ mod integrate;
 mod neighbors;
 mod schemes;
 
+pub use decomp::RankState;
 pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
