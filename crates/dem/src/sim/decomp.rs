@@ -210,6 +210,14 @@ impl<L: ContactLaw> Simulation<L> {
     /// particles. Rank 0 keeps the energy accounts of the set-up, the others start theirs from zero, so
     /// that the sums over ranks are the run's.
     pub fn decompose(&mut self, comm: &dyn Comm) -> Result<(), DemError> {
+        let points = self.particles.pos.clone();
+        self.decompose_over(comm, &points)
+    }
+
+    /// [`Self::decompose`] with the split of space balanced over `points` (the same on every rank)
+    /// instead of the particles present: for a scene that fills up during the run, points spread over
+    /// where the particles will be.
+    pub fn decompose_over(&mut self, comm: &dyn Comm, points: &[Vec3]) -> Result<(), DemError> {
         if comm.size() == 1 || self.decomp.is_some() {
             return Ok(());
         }
@@ -220,13 +228,12 @@ impl<L: ContactLaw> Simulation<L> {
             return Err(self.refuse(format!("the integrator {:?}", self.settings.integrator)));
         }
         // No periodic axes: the domain only has to be finite (the boxes' outer faces are infinite).
-        let bounds = Aabb::from_points(&self.particles.pos);
-        let rcb = Rcb::from_points(&self.particles.pos, comm.size(), bounds, [false; 3]).map_err(|e| {
-            DemError::Config {
+        let bounds = Aabb::from_points(points);
+        let rcb =
+            Rcb::from_points(points, comm.size(), bounds, [false; 3]).map_err(|e| DemError::Config {
                 key: "ranks".into(),
                 message: format!("splitting the particles over the ranks: {e}"),
-            }
-        })?;
+            })?;
         let rank = comm.rank();
         let pending = self.collect_carries();
         let owned: Vec<bool> = self.particles.pos.iter().map(|&x| rcb.owner(x) == rank).collect();
@@ -349,6 +356,16 @@ impl<L: ContactLaw> Simulation<L> {
                     v.fill(0.0);
                 }
             }
+        }
+    }
+
+    /// [`Self::add_particle`] on a run split over ranks: every rank calls it with the same particle; the
+    /// rank whose box holds it adds it, the others only count its id (ids stay those of a one-rank run).
+    /// Not split, the plain method.
+    pub fn add_particle_split(&mut self, p: crate::particles::NewParticle) -> u32 {
+        match &self.decomp {
+            Some(d) if d.rcb.owner(p.pos) != d.rank => self.particles.skip_id(),
+            _ => self.add_particle(p),
         }
     }
 
