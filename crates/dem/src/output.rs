@@ -55,6 +55,12 @@ pub fn energy_row<L: ContactLaw>(sim: &Simulation<L>, e: &EnergyReport) -> Vec<f
 /// sphere) and the body's orientation as the space directions of its first and third principal axes,
 /// `body_axis_1` and `body_axis_3` (zero for a free sphere).
 pub fn write_particles<L: ContactLaw>(sim: &Simulation<L>, path: &Path) -> io::Result<()> {
+    particles_vtu(sim).write(path)
+}
+
+/// The particle output of [`write_particles`] before it is written (a run on ranks writes one piece per
+/// rank and a `.pvtu` naming them).
+pub fn particles_vtu<L: ContactLaw>(sim: &Simulation<L>) -> Vtu {
     let p = &sim.particles;
     let mut vtu = Vtu::point_cloud(&p.pos)
         .point_int("id", &p.id.iter().map(|&i| i as i64).collect::<Vec<_>>())
@@ -78,7 +84,7 @@ pub fn write_particles<L: ContactLaw>(sim: &Simulation<L>, path: &Path) -> io::R
             .point_vector("body_axis_1", &axis(Vec3::X))
             .point_vector("body_axis_3", &axis(Vec3::Z));
     }
-    vtu.write(path)
+    vtu
 }
 
 /// Columns of `bodies.csv` (one row per rigid body per output).

@@ -108,6 +108,14 @@ impl Particles {
         id
     }
 
+    /// Takes the next id without adding a particle: on a run split over ranks, every rank counts the ids
+    /// of the particles added on the others, so that ids stay those of a one-rank run.
+    pub(crate) fn skip_id(&mut self) -> u32 {
+        let id = self.next_id;
+        self.next_id += 1;
+        id
+    }
+
     /// Appends a member sphere of body `body` that carries the body's inverse mass `inv_mass` \[1/kg\]
     /// (the mass its contacts see); returns its id.
     pub(crate) fn push_member(&mut self, p: NewParticle, inv_mass: f64, body: u32) -> u32 {

@@ -79,7 +79,7 @@ macro_rules! kinds {
 }
 
 kinds! {
-    "dem" => Dem(spatter_workflows::dem_scene::SceneConfig, spatter_workflows::dem_scene::run), ranks = false,
+    "dem" => Dem(spatter_workflows::dem_scene::SceneConfig, spatter_workflows::dem_scene::run), ranks = true,
         "A DEM scene: materials, particles (fills, injectors), walls (planes, cylinders, STL meshes with motion).";
     "sph" => Sph(spatter_workflows::sph_scene::SphConfig, spatter_workflows::sph_scene::run), ranks = true,
         "Free-surface water (WCSPH) with walls and moving bodies: wetting maps, splash heights, probes.";

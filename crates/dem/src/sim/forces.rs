@@ -46,7 +46,7 @@ pub(crate) struct Acc {
 }
 
 impl Acc {
-    fn combine(a: Acc, b: Acc) -> Acc {
+    pub(super) fn combine(a: Acc, b: Acc) -> Acc {
         let (max_ratio, worst) =
             if b.max_ratio > a.max_ratio { (b.max_ratio, b.worst) } else { (a.max_ratio, a.worst) };
         Acc {
@@ -61,7 +61,7 @@ impl Acc {
     }
 
     #[inline]
-    fn note_overlap(&mut self, ratio: f64, a: u32, b: u32) {
+    pub(super) fn note_overlap(&mut self, ratio: f64, a: u32, b: u32) {
         if ratio > self.max_ratio || ratio.is_nan() {
             self.max_ratio = if ratio.is_nan() { f64::INFINITY } else { ratio };
             self.worst = (a, b);
@@ -455,6 +455,14 @@ impl<L: ContactLaw> Simulation<L> {
                 &Acc::combine,
             )
             .unwrap_or_default();
+            acc = Acc::combine(acc, a);
+        }
+        // Contacts with the particles of other ranks (decomposed runs only).
+        if let Some(d) = self.decomp.as_mut() {
+            let view = ParticleView { id, material, pos, vel, omega, radius, inv_mass };
+            let forces = (&mut force[..], &mut torque[..]);
+            let a =
+                super::decomp::ghost_contacts(law, params, &mut d.ghosts, &view, range_quick, cdt, forces);
             acc = Acc::combine(acc, a);
         }
 

@@ -17,12 +17,14 @@
 //! Symplectic Euler evaluates the forces first, then kicks by a full step and drifts.
 
 mod clumps;
+mod decomp;
 mod forces;
 mod impacts;
 mod integrate;
 mod neighbors;
 mod schemes;
 
+pub use decomp::RankState;
 pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
@@ -330,6 +332,8 @@ pub struct Simulation<L: ContactLaw> {
     stage: schemes::StageBuffers<L::State>,
     /// Force evaluations since the simulation was made (not part of the state; for benchmarks).
     evaluations: u64,
+    /// This rank's share of a run split over several ranks (`None` on one rank).
+    decomp: Option<decomp::Decomp<L::State>>,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -370,6 +374,7 @@ impl<L: ContactLaw> Simulation<L> {
             trial_dt: None,
             stage: Default::default(),
             evaluations: 0,
+            decomp: None,
         }
     }
 

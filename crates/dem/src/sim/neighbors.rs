@@ -64,8 +64,17 @@ impl<L: ContactLaw> Simulation<L> {
     /// Rebuilds the neighbour and wall lists: removes particles outside the domain, sorts the particle
     /// arrays by cell, builds the half list and the wall candidates, and restores every contact state.
     pub(crate) fn rebuild(&mut self) {
+        let (carry, wall_carry) = self.collect_carries();
+        self.remove_outside_domain();
+        let r_max = self.particles.radius.iter().copied().fold(0.0, f64::max);
+        self.build_lists(r_max, &carry, &wall_carry);
+        self.finish_rebuild();
+    }
+
+    /// Step 1 of a rebuild: the states of the pair and wall slots in contact, keyed by ids (pair
+    /// carries sorted by [`pair_key`], wall carries by (particle id, wall, triangle)).
+    pub(super) fn collect_carries(&self) -> Carries<L::State> {
         let default = L::State::default();
-        // 1. Carry the active states, keyed by ids.
         let mut carry: Vec<(u64, L::State)> = Vec::new();
         {
             let p = &self.particles;
@@ -82,8 +91,6 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         carry.sort_unstable_by_key(|c| c.0);
-        // (particle id, wall, triangle), state and last output of every slot in contact.
-        type WallCarry<S> = ((u32, u16, u32), S, SlotOut);
         let mut wall_carry: Vec<WallCarry<L::State>> = Vec::new();
         {
             let p = &self.particles;
@@ -100,8 +107,12 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         wall_carry.sort_unstable_by_key(|c| c.0);
+        (carry, wall_carry)
+    }
 
-        // 2. Domain: drop particles that left it (a body leaves as a whole when its centre of mass does).
+    /// Step 2 of a rebuild: drops the particles that left the domain (a body leaves as a whole when its
+    /// centre of mass does) and books the energy they take out.
+    pub(super) fn remove_outside_domain(&mut self) {
         if let Some(dom) = self.settings.domain {
             let removed_members = self.remove_bodies_outside(&dom);
             self.st.removed += removed_members as u64;
@@ -127,9 +138,18 @@ impl<L: ContactLaw> Simulation<L> {
             self.particles.retain(|i| is_member(i) || dom.contains(pos[i]));
             self.st.removed += (n0 - self.particles.len()) as u64;
         }
+    }
 
+    /// Steps 3 to 6 of a rebuild, with `r_max` the largest radius \[m\] (over all ranks): sorts the
+    /// particles by cell, builds the half list and the wall candidates, and restores the carried states.
+    pub(super) fn build_lists(
+        &mut self,
+        r_max: f64,
+        carry: &[PairCarry<L::State>],
+        wall_carry: &[WallCarry<L::State>],
+    ) {
+        let default = L::State::default();
         // 3. Sort by cell.
-        let r_max = self.particles.radius.iter().copied().fold(0.0, f64::max);
         self.st.r_max = r_max;
         let (range_pp, range_pw) = self.range_max(r_max);
         let skin = self.skin();
@@ -302,7 +322,10 @@ impl<L: ContactLaw> Simulation<L> {
         self.scratch.grid = spatter_core::grid::CellGrid::new();
         self.scratch.perm = Vec::new();
         self.scratch.permute = crate::particles::PermuteScratch::default();
+    }
 
+    /// The end of a rebuild: displacement bounds reset, counters, clump members.
+    pub(super) fn finish_rebuild(&mut self) {
         self.st.disp_particles = 0.0;
         self.st.disp_walls = 0.0;
         self.st.needs_rebuild = false;
@@ -311,9 +334,18 @@ impl<L: ContactLaw> Simulation<L> {
     }
 }
 
+/// The state of a pair slot in contact, keyed by [`pair_key`] of the two ids.
+pub(super) type PairCarry<S> = (u64, S);
+
+/// (particle id, wall, triangle), state and last output of a wall slot in contact.
+pub(super) type WallCarry<S> = ((u32, u16, u32), S, SlotOut);
+
+/// The pair and wall carries of a rebuild.
+pub(super) type Carries<S> = (Vec<PairCarry<S>>, Vec<WallCarry<S>>);
+
 /// Order-independent key of a particle pair.
 #[inline]
-fn pair_key(a: u32, b: u32) -> u64 {
+pub(super) fn pair_key(a: u32, b: u32) -> u64 {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
     ((lo as u64) << 32) | hi as u64
 }

@@ -5,6 +5,7 @@ use super::events::{trajectory_rows, EventLog, TRAJECTORY_COLUMNS};
 use super::setup;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
+use spatter_core::comm::{Comm, SERIAL};
 use spatter_core::control::Finished;
 use spatter_core::{Aabb, Vec3};
 use spatter_dem::adhesion::{DmtLaw, JkrLaw, SjkrLaw};
@@ -15,12 +16,15 @@ use spatter_dem::contact::{
 };
 use spatter_dem::error::DemError;
 use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
-use spatter_dem::output::{body_rows, energy_row, write_mesh, write_particles, BODY_COLUMNS, ENERGY_COLUMNS};
+use spatter_dem::output::{
+    body_rows, energy_row, particles_vtu, write_mesh, write_particles, BODY_COLUMNS, ENERGY_COLUMNS,
+};
 use spatter_dem::restitution_models::{RestitutionModel, SpeedDependentDamping};
-use spatter_dem::sim::{SimState, Simulation};
+use spatter_dem::sim::{Integrator, RankState, SimState, Simulation};
 use spatter_dem::timestep;
 use spatter_io::csv::CsvSeries;
 use spatter_io::pvd::PvdSeries;
+use spatter_io::rank_checkpoint::Resumed;
 use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
 
 /// Everything a resumed run needs (the checkpoint header names the input it belongs to: a resume with
@@ -46,6 +50,83 @@ struct Checkpoint<S, P> {
     pour: Option<super::pour::PourState>,
     /// The probe's state and samples (None without `[probe]`).
     probe: Option<super::probe::ProbeState>,
+}
+
+/// One rank's part of a checkpoint written on several ranks: the scene's checkpoint with this rank's
+/// particles and partial sums (energy accounts, mesh records; rank 0 also the file offsets), and the
+/// split of space with the contact states across it.
+#[derive(Serialize, Deserialize)]
+struct RankPart<S, P> {
+    scene: Checkpoint<S, P>,
+    rank: Option<RankState<S>>,
+}
+
+/// What runs on one rank only: a run on several ranks (`mpirun`) with any of these is refused with one
+/// sentence naming the key.
+fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result<(), DemError> {
+    if comm.size() == 1 {
+        return Ok(());
+    }
+    let one_rank = [
+        ("templates", !cfg.templates.is_empty()),
+        ("inject.clumps", cfg.inject.iter().any(|j| j.clumps.is_some())),
+        ("pour", cfg.pour.is_some()),
+        ("bed", cfg.bed.is_some()),
+        ("probe", cfg.probe.is_some()),
+        ("output.events", cfg.output.events.is_some()),
+        ("output.trajectories", cfg.output.trajectories.is_some()),
+        (
+            "engine.integrator",
+            !matches!(cfg.engine.integrator, Integrator::VelocityVerlet | Integrator::SymplecticEuler),
+        ),
+        ("(forces from a flow)", external),
+    ];
+    match one_rank.iter().find(|(_, on)| *on) {
+        None => Ok(()),
+        Some((key, _)) => Err(DemError::Config {
+            key: (*key).into(),
+            message: format!(
+                "runs on one rank only in this version, and this run has {} ranks: remove `{key}` (or use \
+                 velocity_verlet or symplectic_euler for engine.integrator), or start the run without mpirun",
+                comm.size()
+            ),
+        }),
+    }
+}
+
+/// The points the split over ranks balances: the particles at the start, and for a scene with
+/// injection also a 16 × 16 × 16 lattice over where particles will be (the engine's domain when given,
+/// else the box around the injection regions, the mesh walls and the particles).
+fn split_points<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<Vec3> {
+    let mut points = sim.particles.pos.clone();
+    if cfg.inject.is_empty() {
+        return points;
+    }
+    let b = match (cfg.engine.domain_min_m, cfg.engine.domain_max_m) {
+        (Some(a), Some(b)) => Aabb::new(a, b),
+        _ => {
+            let mut b = Aabb::from_points(&points);
+            for j in &cfg.inject {
+                if let Ok(r) = setup::region(&j.region) {
+                    b = b.union(r.bounds());
+                }
+            }
+            for w in &sim.walls {
+                if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
+                    b = b.union(m.mesh.bounds());
+                }
+            }
+            b
+        }
+    };
+    const N: usize = 16;
+    let e = b.extent();
+    for k in 0..N * N * N {
+        let (i, j, l) = (k % N, (k / N) % N, k / (N * N));
+        let f = |n: usize| (n as f64 + 0.5) / N as f64;
+        points.push(b.min + Vec3::new(f(i) * e.x, f(j) * e.y, f(l) * e.z));
+    }
+    points
 }
 
 /// Runs a DEM scene into `ctx.dir`: `energy.csv`, `particles.pvd` + `particles/*.vtu`, and for every mesh
@@ -306,7 +387,15 @@ pub fn with_law<V: WithLaw>(cfg: &SceneConfig, v: V) -> Result<V::Output, DemErr
     }
 }
 
+/// The outputs of a run; on several ranks only rank 0 holds the files.
 struct Outputs {
+    /// The files rank 0 writes (`None` on the other ranks).
+    files: Option<OutputFiles>,
+    /// Outputs written so far.
+    index: u64,
+}
+
+struct OutputFiles {
     csv: CsvSeries,
     particles: PvdSeries,
     meshes: Vec<Option<PvdSeries>>,
@@ -316,7 +405,6 @@ struct Outputs {
     wear: Option<CsvSeries>,
     /// `trajectories.csv` (with `[output.trajectories]`).
     trajectories: Option<CsvSeries>,
-    index: u64,
 }
 
 /// Columns of `wear.csv`: time, then per mesh wall its eroded mass and impacts so far.
@@ -354,6 +442,89 @@ fn series(path: &std::path::Path, columns: &[String], resume: Option<u64>) -> Re
 impl Outputs {
     /// Flushes the CSV series.
     fn flush(&mut self) -> Result<(), DemError> {
+        let Some(f) = self.files.as_mut() else { return Ok(()) };
+        f.flush()
+    }
+
+    /// Writes output number `index` (collective on several ranks: the totals are summed over the ranks,
+    /// every rank writes its piece of the particles, rank 0 the rest).
+    fn write<L: ContactLaw>(
+        &mut self,
+        cfg: &SceneConfig,
+        sim: &mut Simulation<L>,
+        ctx: &RunContext,
+    ) -> Result<(), DemError> {
+        let comm = ctx.comm;
+        let e = sim.energy_with(comm);
+        let count = sim.particle_count_with(comm);
+        sim.gather_mesh_records(comm);
+        let rel = match cfg.output.particles_vtu {
+            true => Some(write_particle_output(sim, ctx, self.index)?),
+            false => None,
+        };
+        if let Some(f) = self.files.as_mut() {
+            f.write(cfg, sim, ctx, (&e, count), rel.as_deref(), self.index)?;
+        }
+        self.index += 1;
+        Ok(())
+    }
+
+    /// Bytes written to each CSV series (for the checkpoint; zeros on the ranks that write none).
+    fn bytes(&self) -> [u64; 4] {
+        let Some(f) = &self.files else { return [0; 4] };
+        [
+            f.csv.bytes_written(),
+            f.bodies.as_ref().map_or(0, CsvSeries::bytes_written),
+            f.wear.as_ref().map_or(0, CsvSeries::bytes_written),
+            f.trajectories.as_ref().map_or(0, CsvSeries::bytes_written),
+        ]
+    }
+}
+
+/// Writes the particle output number `index`; returns its path relative to the run folder (for the
+/// `.pvd`). One rank: `particles/particles_00012.vtu`. Several: every rank writes its piece
+/// `particles/particles_00012_r0003.vtu` and rank 0 the `particles/particles_00012.pvtu` joining them.
+fn write_particle_output<L: ContactLaw>(
+    sim: &Simulation<L>,
+    ctx: &RunContext,
+    index: u64,
+) -> Result<String, DemError> {
+    let comm = ctx.comm;
+    let io = |p: &std::path::Path| {
+        let p = p.to_owned();
+        move |source| DemError::Io { path: p, source }
+    };
+    if comm.size() == 1 {
+        let rel = format!("particles/particles_{index:05}.vtu");
+        let path = ctx.dir.path(&rel);
+        write_particles(sim, &path).map_err(io(&path))?;
+        return Ok(rel);
+    }
+    let piece = |r: usize| format!("particles_{index:05}_r{r:04}.vtu");
+    let vtu = particles_vtu(sim);
+    let path = ctx.dir.path(&format!("particles/{}", piece(comm.rank())));
+    if let Err(e) = vtu.write(&path) {
+        // The other ranks cannot be told in a collective they are not in: the run ends here.
+        eprintln!(
+            "error on rank {} of {}: {}: {e}; ending the run",
+            comm.rank(),
+            comm.size(),
+            path.display()
+        );
+        comm.abort(1);
+    }
+    let rel = format!("particles/particles_{index:05}.pvtu");
+    if comm.is_root() {
+        let path = ctx.dir.path(&rel);
+        let pieces: Vec<String> = (0..comm.size()).map(piece).collect();
+        vtu.write_pvtu(&path, &pieces).map_err(io(&path))?;
+    }
+    Ok(rel)
+}
+
+impl OutputFiles {
+    /// Flushes the CSV series.
+    fn flush(&mut self) -> Result<(), DemError> {
         let all = [Some(&mut self.csv), self.bodies.as_mut(), self.wear.as_mut(), self.trajectories.as_mut()];
         for s in all.into_iter().flatten() {
             s.flush().map_err(|source| DemError::Io { path: s.path().to_owned(), source })?;
@@ -361,18 +532,24 @@ impl Outputs {
         Ok(())
     }
 
+    /// Rank 0's part of an output: the energy row (`e` and the particle `count` over all ranks), bodies,
+    /// wear, the `.pvd` entry of the particle output `rel` and the mesh walls.
     fn write<L: ContactLaw>(
         &mut self,
         cfg: &SceneConfig,
         sim: &Simulation<L>,
         ctx: &RunContext,
+        (e, count): (&spatter_dem::EnergyReport, u64),
+        rel: Option<&str>,
+        index: u64,
     ) -> Result<(), DemError> {
         let io = |p: &std::path::Path| {
             let p = p.to_owned();
             move |source| DemError::Io { path: p, source }
         };
-        let e = sim.energy();
-        self.csv.row(&energy_row(sim, &e)).map_err(io(self.csv.path()))?;
+        let mut row = energy_row(sim, e);
+        row[2] = count as f64;
+        self.csv.row(&row).map_err(io(self.csv.path()))?;
         if let Some(b) = &mut self.bodies {
             for row in body_rows(sim) {
                 b.row(&row).map_err(io(b.path()))?;
@@ -382,23 +559,19 @@ impl Outputs {
             w.row(&wear_row(sim)).map_err(io(w.path()))?;
         }
         let t = sim.time();
-        if cfg.output.particles_vtu {
-            let rel = format!("particles/particles_{:05}.vtu", self.index);
-            let path = ctx.dir.path(&rel);
-            write_particles(sim, &path).map_err(io(&path))?;
-            self.particles.push(t, &rel).map_err(io(&ctx.dir.path("particles.pvd")))?;
+        if let Some(rel) = rel {
+            self.particles.push(t, rel).map_err(io(&ctx.dir.path("particles.pvd")))?;
         }
         if cfg.output.mesh_vtu {
             for (w, series) in self.meshes.iter_mut().enumerate() {
                 if let Some(series) = series {
-                    let rel = format!("walls/{}_{:05}.vtu", sim.walls[w].name, self.index);
+                    let rel = format!("walls/{}_{index:05}.vtu", sim.walls[w].name);
                     let path = ctx.dir.path(&rel);
                     write_mesh(sim, w, &path).map_err(io(&path))?;
                     series.push(t, &rel).map_err(io(&path))?;
                 }
             }
         }
-        self.index += 1;
         Ok(())
     }
 }
@@ -452,6 +625,9 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     ctx: &RunContext,
     mut partner: P,
 ) -> Result<(RunSummary, Option<SceneResults>), P::Error> {
+    let comm = ctx.comm;
+    let (root, ranks) = (comm.is_root(), comm.size() > 1);
+    refuse_on_ranks(cfg, built.external.is_some(), comm)?;
     let mut sim = simulation(law, built, cfg);
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
@@ -486,8 +662,29 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     let mut probe = None;
     let probe_every = cfg.probe.as_ref().map_or(1, |p| super::probe::sample_every(p, cfg.dt_s));
     if ctx.resume {
-        let ck: Checkpoint<L::State, P::State> = ctx.load_checkpoint().map_err(DemError::from)?;
+        let (ck, rank_state) = if ranks {
+            match ctx.load_checkpoint_parts::<(), RankPart<L::State, P::State>>().map_err(DemError::from)? {
+                Resumed::Mine(part) => (part.scene, part.rank),
+                Resumed::Whole(()) | Resumed::All(_) => return Err(DemError::Resume(format!(
+                    "a DEM run resumes on as many ranks as wrote its checkpoint in this version (this run \
+                         has {}; --repartition is for the sph kind)",
+                    comm.size()
+                ))
+                .into()),
+            }
+        } else {
+            (ctx.load_checkpoint().map_err(DemError::from)?, None)
+        };
         sim.restore(ck.sim).map_err(DemError::Resume)?;
+        match rank_state {
+            Some(rs) => sim.restore_rank_state(rs, comm)?,
+            None if ranks => {
+                return Err(
+                    DemError::Resume("the checkpoint part holds no split over the ranks".into()).into()
+                )
+            }
+            None => {}
+        }
         partner.restore(ck.partner, ctx, sim.time())?;
         if ck.injectors.len() != injectors.len() {
             return Err(DemError::Resume("the number of injectors changed".into()).into());
@@ -496,39 +693,45 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             slot.0.state = state;
         }
         let t = sim.time();
-        let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
-        particles.truncate_after(t).map_err(io(&pvd_path))?;
-        let mut meshes = Vec::new();
-        for w in 0..sim.walls.len() {
-            meshes.push(if sim.is_mesh_wall(w) {
-                let p = mesh_pvd(&sim.walls[w].name);
-                let mut s = PvdSeries::load_or_new(&p).map_err(io(&p))?;
-                s.truncate_after(t).map_err(io(&p))?;
-                Some(s)
-            } else {
-                None
-            });
-        }
-        out = Outputs {
-            csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
-            particles,
-            meshes,
-            bodies: match has_bodies {
-                true => Some(series(&bodies_path, &body_columns, Some(ck.bodies_csv_bytes))?),
-                false => None,
-            },
-            wear: match has_wear {
-                true => Some(series(&wear_path, &wear_columns(&sim), Some(ck.wear_csv_bytes))?),
-                false => None,
-            },
-            trajectories: match cfg.output.trajectories {
-                Some(_) => {
-                    Some(series(&trajectories_path, &trajectory_columns, Some(ck.trajectories_csv_bytes))?)
-                }
-                None => None,
-            },
-            index: ck.output_index,
+        let files = if root {
+            let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
+            particles.truncate_after(t).map_err(io(&pvd_path))?;
+            let mut meshes = Vec::new();
+            for w in 0..sim.walls.len() {
+                meshes.push(if sim.is_mesh_wall(w) {
+                    let p = mesh_pvd(&sim.walls[w].name);
+                    let mut s = PvdSeries::load_or_new(&p).map_err(io(&p))?;
+                    s.truncate_after(t).map_err(io(&p))?;
+                    Some(s)
+                } else {
+                    None
+                });
+            }
+            Some(OutputFiles {
+                csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
+                particles,
+                meshes,
+                bodies: match has_bodies {
+                    true => Some(series(&bodies_path, &body_columns, Some(ck.bodies_csv_bytes))?),
+                    false => None,
+                },
+                wear: match has_wear {
+                    true => Some(series(&wear_path, &wear_columns(&sim), Some(ck.wear_csv_bytes))?),
+                    false => None,
+                },
+                trajectories: match cfg.output.trajectories {
+                    Some(_) => Some(series(
+                        &trajectories_path,
+                        &trajectory_columns,
+                        Some(ck.trajectories_csv_bytes),
+                    )?),
+                    None => None,
+                },
+            })
+        } else {
+            None
         };
+        out = Outputs { files, index: ck.output_index };
         events = ck.events;
         warnings = ck.warnings;
         if pour.is_some() != ck.pour.is_some() {
@@ -562,50 +765,65 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         for w in &warnings {
             tracing::warn!("{w}");
         }
-        let meshes = (0..sim.walls.len())
-            .map(|w| sim.is_mesh_wall(w).then(|| PvdSeries::new(&mesh_pvd(&sim.walls[w].name))))
-            .collect();
-        out = Outputs {
-            csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
-            particles: PvdSeries::new(&pvd_path),
-            meshes,
-            bodies: match has_bodies {
-                true => Some(series(&bodies_path, &body_columns, None)?),
-                false => None,
-            },
-            wear: match has_wear {
-                true => Some(series(&wear_path, &wear_columns(&sim), None)?),
-                false => None,
-            },
-            trajectories: match cfg.output.trajectories {
-                Some(_) => Some(series(&trajectories_path, &trajectory_columns, None)?),
-                None => None,
-            },
-            index: 0,
+        // Every rank built the whole set-up: each keeps the particles in its box.
+        if ranks {
+            sim.decompose_over(comm, &split_points(cfg, &sim))?;
+        }
+        let files = if root {
+            let meshes = (0..sim.walls.len())
+                .map(|w| sim.is_mesh_wall(w).then(|| PvdSeries::new(&mesh_pvd(&sim.walls[w].name))))
+                .collect();
+            Some(OutputFiles {
+                csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
+                particles: PvdSeries::new(&pvd_path),
+                meshes,
+                bodies: match has_bodies {
+                    true => Some(series(&bodies_path, &body_columns, None)?),
+                    false => None,
+                },
+                wear: match has_wear {
+                    true => Some(series(&wear_path, &wear_columns(&sim), None)?),
+                    false => None,
+                },
+                trajectories: match cfg.output.trajectories {
+                    Some(_) => Some(series(&trajectories_path, &trajectory_columns, None)?),
+                    None => None,
+                },
+            })
+        } else {
+            None
         };
-        out.write(cfg, &sim, ctx)?;
+        out = Outputs { files, index: 0 };
+        out.write(cfg, &mut sim, ctx)?;
         partner.output(&sim, ctx)?;
     }
 
     while sim.step_count() < total_steps {
-        let stop = ctx.control.stop_requested();
-        if stop || ctx.checkpoint_due() {
+        let poll = ctx.poll();
+        let stop = poll.stop;
+        if stop || poll.checkpoint {
             out.flush()?;
+            let [csv_bytes, bodies_csv_bytes, wear_csv_bytes, trajectories_csv_bytes] = out.bytes();
             let ck = Checkpoint {
                 sim: sim.state(),
                 partner: partner.state(),
                 injectors: injectors.iter().map(|(i, _)| i.state.clone()).collect(),
                 output_index: out.index,
-                csv_bytes: out.csv.bytes_written(),
-                bodies_csv_bytes: out.bodies.as_ref().map_or(0, CsvSeries::bytes_written),
-                wear_csv_bytes: out.wear.as_ref().map_or(0, CsvSeries::bytes_written),
-                trajectories_csv_bytes: out.trajectories.as_ref().map_or(0, CsvSeries::bytes_written),
+                csv_bytes,
+                bodies_csv_bytes,
+                wear_csv_bytes,
+                trajectories_csv_bytes,
                 events: events.clone(),
                 warnings: warnings.clone(),
                 pour: pour.clone(),
                 probe: probe.clone(),
             };
-            ctx.save_checkpoint(&ck).map_err(DemError::from)?;
+            if ranks {
+                let part = RankPart { scene: ck, rank: sim.rank_state() };
+                ctx.save_checkpoint_part(&part).map_err(DemError::from)?;
+            } else {
+                ctx.save_checkpoint(&ck).map_err(DemError::from)?;
+            }
             write_events(cfg, &sim, &events, ctx)?;
         }
         if stop {
@@ -620,7 +838,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         let step = sim.step_count();
         for (k, (inj, region)) in injectors.iter_mut().enumerate() {
             if step % inject_every[k] == 0 {
-                inject(&mut sim, inj, region, k);
+                inject_with(&mut sim, inj, region, k, comm);
             }
         }
         if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
@@ -637,14 +855,15 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             sim.request_energy();
         }
         partner.before_step(&mut sim)?;
-        sim.step()?;
+        sim.step_with(comm)?;
         if let (Some(p), Some(st)) = (&cfg.probe, probe.as_mut()) {
             super::probe::after_step(p, &sim, st, probe_every);
         }
         if let Some(e) = &cfg.output.events {
             events.after_step(&sim, e);
         }
-        if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, &mut out.trajectories) {
+        let trajectories = out.files.as_mut().and_then(|f| f.trajectories.as_mut());
+        if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, trajectories) {
             if sim.step_count() % tc.every_steps == 0 {
                 for row in trajectory_rows(&sim, tc) {
                     tr.row(&row).map_err(io(tr.path()))?;
@@ -652,7 +871,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             }
         }
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps || probe_ends {
-            out.write(cfg, &sim, ctx)?;
+            out.write(cfg, &mut sim, ctx)?;
             partner.output(&sim, ctx)?;
             // A pour is checked for rest at the outputs, so that a run ending early ends on one.
             if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
@@ -675,8 +894,21 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     }
     out.flush()?;
     write_events(cfg, &sim, &events, ctx)?;
-    let _ = std::fs::remove_file(dir.checkpoint_path());
-    let mut s = summary(cfg, &sim, &injectors, &warnings, ctx);
+    if ranks {
+        if root {
+            spatter_io::rank_checkpoint::remove(dir.root()).map_err(io(&dir.checkpoint_path()))?;
+        }
+    } else {
+        let _ = std::fs::remove_file(dir.checkpoint_path());
+    }
+    // Totals over the ranks (collective), then rank 0 holds the whole mesh records.
+    let totals = Totals {
+        energy: sim.energy_with(comm),
+        particles: sim.particle_count_with(comm),
+        removed: sim.removed_count_with(comm),
+    };
+    sim.gather_mesh_records(comm);
+    let mut s = summary(cfg, &sim, &totals, &injectors, &warnings, ctx);
     super::bed_outputs::finish(cfg, &sim, pour.as_ref(), ctx, &mut s)?;
     if let (Some(p), Some(st)) = (&cfg.probe, &probe) {
         super::probe::finish(p, st, ctx, &mut s)?;
@@ -693,13 +925,15 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     if cfg.output.trajectories.is_some() {
         s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
     }
-    for (name, png, record) in write_wear_maps(&sim, ctx)? {
+    let maps = if root { write_wear_maps(&sim, ctx)? } else { Vec::new() };
+    for (name, png, record) in maps {
         s.artifacts.push((format!("eroded mass map {name}"), png));
         s.artifacts.push((format!("eroded mass per triangle {name} (VTU)"), record.vtu.clone()));
         s.maps.push(record);
     }
     partner.finish(&sim, ctx, &mut s)?;
-    let r = results(&sim, events);
+    let mut r = results(&sim, events);
+    r.removed_spheres = totals.removed;
     Ok((s, Some(r)))
 }
 
@@ -775,14 +1009,34 @@ fn write_wear_maps<L: ContactLaw>(
 /// Places the particles injector `k` owes at the current time, clear of the particles present and of the
 /// walls where they are now.
 pub(crate) fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector, region: &Region, k: usize) {
+    inject_with(sim, inj, region, k, &SERIAL);
+}
+
+/// [`inject`] on the ranks of `comm` (collective): the particles near the region are gathered from
+/// every rank (sorted by id; the placement only asks whether a place is free, so their order does not
+/// matter), every rank places the same particles, and each keeps those in its box.
+fn inject_with<L: ContactLaw>(
+    sim: &mut Simulation<L>,
+    inj: &mut Injector,
+    region: &Region,
+    k: usize,
+    comm: &dyn Comm,
+) {
     let t = sim.time();
     if t < inj.start || (inj.due(t) == 0 && inj.state.pending.is_some()) {
         return;
     }
-    let reach = region.bounds().inflated(sim.particles.radius.iter().copied().fold(0.0, f64::max));
+    let mut r_max = [sim.particles.radius.iter().copied().fold(0.0, f64::max)];
+    if sim.ranks() > 1 {
+        comm.all_max_f64(&mut r_max);
+    }
+    let reach = region.bounds().inflated(r_max[0]);
     let p = &sim.particles;
-    let existing: Vec<_> =
+    let mut existing: Vec<_> =
         (0..p.len()).filter(|&i| reach.contains(p.pos[i])).map(|i| (p.pos[i], p.radius[i])).collect();
+    if sim.ranks() > 1 {
+        existing = gather_near(sim, reach, comm);
+    }
     let postponed = inj.state.postponed;
     let walls = WallClearance::new(&sim.walls, t);
     if let Some(mix) = inj.clumps.clone() {
@@ -818,8 +1072,27 @@ pub(crate) fn inject<L: ContactLaw>(sim: &mut Simulation<L>, inj: &mut Injector,
     for (x, r) in placed {
         let mut np = spatter_dem::particles::NewParticle::at(x, r, inj.material);
         np.vel = inj.velocity;
-        sim.add_particle(np);
+        sim.add_particle_split(np);
     }
+}
+
+/// Position and radius of every particle inside `reach` on any rank, in id order (collective).
+fn gather_near<L: ContactLaw>(sim: &Simulation<L>, reach: Aabb, comm: &dyn Comm) -> Vec<(Vec3, f64)> {
+    let p = &sim.particles;
+    let mut w = spatter_core::comm::WireWriter::with_capacity(0);
+    for i in (0..p.len()).filter(|&i| reach.contains(p.pos[i])) {
+        w.u32(p.id[i]).vec3(p.pos[i]).f64(p.radius[i]);
+    }
+    let mut all: Vec<(u32, Vec3, f64)> = Vec::new();
+    for buf in comm.all_gather_bytes(&w.finish()) {
+        let mut r = spatter_core::comm::WireReader::new(&buf);
+        let bad = "particle message from another rank of this run";
+        while !r.is_done() {
+            all.push((r.u32().expect(bad), r.vec3().expect(bad), r.f64().expect(bad)));
+        }
+    }
+    all.sort_unstable_by_key(|a| a.0);
+    all.into_iter().map(|(_, x, r)| (x, r)).collect()
 }
 
 /// Time-step warnings for the particles present and to be injected.
@@ -906,23 +1179,32 @@ pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulat
     out
 }
 
+/// The run's totals over all ranks (the plain values on one rank).
+struct Totals {
+    energy: spatter_dem::EnergyReport,
+    particles: u64,
+    removed: u64,
+}
+
 fn summary<L: ContactLaw>(
     cfg: &SceneConfig,
     sim: &Simulation<L>,
+    totals: &Totals,
     injectors: &[(Injector, Region)],
     warnings: &[String],
     ctx: &RunContext,
 ) -> RunSummary {
     let mut s = RunSummary::new(Finished::Completed);
-    let e = sim.energy();
+    let e = totals.energy;
     s.headline.push(format!(
-        "{} particles, {} steps of {:e} s to t = {:.6} s, {} list rebuilds, {} removed",
-        sim.particles.len(),
+        "{} particles, {} steps of {:e} s to t = {:.6} s, {} list rebuilds, {} removed{}",
+        totals.particles,
         sim.step_count(),
         cfg.dt_s,
         sim.time(),
         sim.rebuild_count(),
-        sim.removed_count()
+        totals.removed,
+        if sim.ranks() > 1 { format!(" (on {} ranks)", sim.ranks()) } else { String::new() }
     ));
     s.headline.push(format!(
         "energy [J]: kinetic {:.4e}, rotational {:.4e}, elastic {:.4e}, dissipated {:.4e}, budget total {:.6e}",
@@ -954,8 +1236,8 @@ fn summary<L: ContactLaw>(
         ));
     }
     for (name, value) in [
-        ("particles", sim.particles.len() as f64),
-        ("removed", sim.removed_count() as f64),
+        ("particles", totals.particles as f64),
+        ("removed", totals.removed as f64),
         ("t_end_s", sim.time()),
         ("kinetic_J", e.kinetic),
         ("rotational_J", e.rotational),
