@@ -665,12 +665,14 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         let (ck, rank_state) = if ranks {
             match ctx.load_checkpoint_parts::<(), RankPart<L::State, P::State>>().map_err(DemError::from)? {
                 Resumed::Mine(part) => (part.scene, part.rank),
-                Resumed::Whole(()) | Resumed::All(_) => return Err(DemError::Resume(format!(
+                Resumed::Whole(()) | Resumed::All(_) => {
+                    return Err(DemError::Resume(format!(
                     "a DEM run resumes on as many ranks as wrote its checkpoint in this version (this run \
                          has {}; --repartition is for the sph kind)",
                     comm.size()
                 ))
-                .into()),
+                    .into())
+                }
             }
         } else {
             (ctx.load_checkpoint().map_err(DemError::from)?, None)
