@@ -8,7 +8,7 @@
 //! `length_scale`), as in the rest of the workflow.
 
 use super::config::BrownoutConfig;
-use crate::deposition::config::vtk_file;
+use crate::deposition::config::{vtk_file, vtk_series};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
 use spatter_flow::field::imported::{ArrayNames, ImportOptions, ImportedField, Interpolation};
@@ -109,20 +109,7 @@ impl Validate for ImportedFlowConfig {
                 c.fail("vtk", "give the field: vtk = \"file.vtu\" (steady) or series = \"file.pvd\"")
             }
             (Some(p), None) => vtk_file(c, "vtk", p),
-            (None, Some(p)) => {
-                let full = c.resolve(p);
-                if !full.is_file() {
-                    c.file_exists("series", p);
-                } else {
-                    match spatter_io::vtk::series::read_series(&full) {
-                        Err(e) => c.fail("series", format!("series = \"{}\": {e}", p.display())),
-                        Ok(list) => match list.first() {
-                            None => c.fail("series", format!("series = \"{}\" lists no files", p.display())),
-                            Some((_, f)) => vtk_file(c, "series", f),
-                        },
-                    }
-                }
-            }
+            (None, Some(p)) => vtk_series(c, "series", p),
         }
         c.positive("length_scale", self.length_scale);
         if let Some(p) = self.period_s {

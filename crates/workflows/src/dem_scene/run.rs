@@ -94,6 +94,21 @@ fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result
     }
 }
 
+/// `b` grown by the injection regions and the mesh walls: the box particles can reach.
+fn reach_bounds<L: ContactLaw>(mut b: Aabb, cfg: &SceneConfig, sim: &Simulation<L>) -> Aabb {
+    for j in &cfg.inject {
+        if let Ok(r) = setup::region(&j.region) {
+            b = b.union(r.bounds());
+        }
+    }
+    for w in &sim.walls {
+        if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
+            b = b.union(m.mesh.bounds());
+        }
+    }
+    b
+}
+
 /// The points the split over ranks balances: the particles at the start, and for a scene with
 /// injection also a 16 × 16 × 16 lattice over where particles will be (the engine's domain when given,
 /// else the box around the injection regions, the mesh walls and the particles).
@@ -104,20 +119,7 @@ fn split_points<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<Ve
     }
     let b = match (cfg.engine.domain_min_m, cfg.engine.domain_max_m) {
         (Some(a), Some(b)) => Aabb::new(a, b),
-        _ => {
-            let mut b = Aabb::from_points(&points);
-            for j in &cfg.inject {
-                if let Ok(r) = setup::region(&j.region) {
-                    b = b.union(r.bounds());
-                }
-            }
-            for w in &sim.walls {
-                if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
-                    b = b.union(m.mesh.bounds());
-                }
-            }
-            b
-        }
+        _ => reach_bounds(Aabb::from_points(&points), cfg, sim),
     };
     const N: usize = 16;
     let e = b.extent();
@@ -1130,16 +1132,7 @@ pub(crate) fn time_step_warnings<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulat
         for x in &p.pos {
             b = b.grown_to(*x);
         }
-        for j in &cfg.inject {
-            if let Ok(r) = setup::region(&j.region) {
-                b = b.union(r.bounds());
-            }
-        }
-        for w in &sim.walls {
-            if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
-                b = b.union(m.mesh.bounds());
-            }
-        }
+        let b = reach_bounds(b, cfg, sim);
         let h = if b.is_empty() { 0.0 } else { b.extent().length() };
         let v0 = p.vel.iter().map(|v| v.length()).fold(0.0, f64::max);
         let vi = cfg.inject.iter().map(|j| j.velocity_m_s.length()).fold(0.0, f64::max);

@@ -194,19 +194,7 @@ impl Validate for FlowSpec {
             vtk_file(c, "vtk", p);
         }
         if let Some(p) = &self.series {
-            let full = c.resolve(p);
-            if !full.is_file() {
-                c.file_exists("series", p);
-            } else {
-                match spatter_io::vtk::series::read_series(&full) {
-                    Err(e) => c.fail("series", format!("series = \"{}\": {e}", p.display())),
-                    // The first snapshot is read in full; the others when the run reaches them.
-                    Ok(list) => match list.first() {
-                        None => c.fail("series", format!("series = \"{}\" lists no files", p.display())),
-                        Some((_, f)) => vtk_file(c, "series", f),
-                    },
-                }
-            }
+            vtk_series(c, "series", p);
         }
         for (i, f) in self.files.iter().enumerate() {
             c.element("files", i, |c| {
@@ -249,6 +237,22 @@ pub(crate) fn vtk_file(c: &mut Checker, key: &str, path: &Path) {
     }
     if let Err(e) = spatter_io::vtk::read(&full) {
         c.fail(key, format!("{key} = \"{}\": {e}", path.display()));
+    }
+}
+
+/// `path` must name a time series (`.pvd`) listing at least one file, whose first snapshot passes
+/// [`vtk_file`]; the others are read when the run reaches them. Messages name the key and the file.
+pub(crate) fn vtk_series(c: &mut Checker, key: &str, path: &Path) {
+    let full = c.resolve(path);
+    if !full.is_file() {
+        return c.file_exists(key, path);
+    }
+    match spatter_io::vtk::series::read_series(&full) {
+        Err(e) => c.fail(key, format!("{key} = \"{}\": {e}", path.display())),
+        Ok(list) => match list.first() {
+            None => c.fail(key, format!("{key} = \"{}\" lists no files", path.display())),
+            Some((_, f)) => vtk_file(c, key, f),
+        },
     }
 }
 
