@@ -98,7 +98,8 @@ fn all_ids<L: spatter_dem::contact::ContactLaw>(sim: &Simulation<L>, comm: &dyn 
 }
 
 /// A pile poured into a 10 cm box (frictional floor, frictionless sides, rolling resistance): the
-/// set-up of the engine's settled-pile validation case.
+/// materials, pairs and box of the engine's settled-pile validation case, with this file's own fill
+/// (4–6 mm radii, another random stream), so its numbers differ from the validation case's.
 fn pile(n: usize) -> Simulation<HertzMindlinRolling> {
     let mats = vec![soft(), soft()];
     let base = uniform_pairs(&mats, 0.5, 0.3);

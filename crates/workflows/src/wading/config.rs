@@ -2,11 +2,30 @@
 
 use super::channel::ChannelSpec;
 use super::patches::SensorBox;
+use super::path::VehiclePath;
+use super::timeline::SpeedProfile;
 use super::vehicle::{PartFile, WheelSpec};
 use crate::sph_scene::config::{DragConfig, FluidConfig};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// `file` must exist and `parse` must accept its text, so a garbled table fails at `spatter check`; the
+/// parser's message names the file, line, value and expected form.
+fn parsed_file<T>(c: &mut Checker, key: &str, file: &Path, parse: impl Fn(&str, &Path) -> Result<T, String>) {
+    let full = c.resolve(file);
+    if !full.is_file() {
+        return c.file_exists(key, file);
+    }
+    match std::fs::read_to_string(&full) {
+        Err(e) => c.fail(key, format!("{}: {e}", file.display())),
+        Ok(text) => {
+            if let Err(e) = parse(&text, &full) {
+                c.fail(key, e);
+            }
+        }
+    }
+}
 
 fn d_adhesion() -> f64 {
     1.0
@@ -176,10 +195,14 @@ impl Validate for WadingConfig {
         c.nested("motion", |c| {
             match (self.motion.speed_m_s, &self.motion.file, &self.motion.path) {
             (Some(v), None, None) => c.positive("speed_m_s", v),
-            (None, Some(f), None) => c.file_exists("file", f),
+            (None, Some(f), None) => parsed_file(c, "file", f, SpeedProfile::parse),
             (None, None, Some(p)) => c.nested("path", |c| match (&p.file, &p.rows) {
-                (Some(f), None) => c.file_exists("file", f),
-                (None, Some(_)) => {}
+                (Some(f), None) => parsed_file(c, "file", f, VehiclePath::parse),
+                (None, Some(rows)) => {
+                    if let Err(e) = VehiclePath::from_rows(rows) {
+                        c.fail("rows", e);
+                    }
+                }
                 _ => c.fail(
                     "file",
                     "give exactly one of file (rows `t_s x_m y_m [z_m]`) and rows ([[t, x, y], …] inline)",
