@@ -232,9 +232,13 @@ fn rotor_rate(rotor: &RotorDownwash, starts: &[Vec3], steps: usize) -> Result<(f
 
 /// The rotor benchmark: 20 µm sand parcels (2480 kg/m³) spread over 0.3 < r/R < 2.5 and 0 < z < z_hub
 /// under the Bell 47 at z_d/R = 0.68 (T = 8.8 kN, R = 5.66 m, Ω = 35.6 rad/s, 10 revolutions of tip
-/// vortices), Schiller–Naumann drag and gravity, Δt = 1 ms, one thread. `quick`: fewer parcels and steps.
+/// vortices), Schiller–Naumann drag and gravity, Δt = 1 ms, one thread. The mean flow and the tabulated
+/// vortices are timed alternately, [`ROTOR_ROUNDS`] times each, and the fastest round of each is kept (a
+/// busy machine only ever slows a round down). `quick`: fewer steps.
 pub fn rotor_bench(quick: bool) -> Result<Vec<String>, FieldError> {
-    let (n, steps, n_direct, steps_direct) = if quick { (2000, 5, 200, 2) } else { (20_000, 20, 1000, 3) };
+    // The quick run keeps the parcel count: with a tenth of the parcels their state fits in the core's
+    // cache and the mean flow alone runs faster, which is not the regime of a brownout cloud.
+    let (n, steps, n_direct, steps_direct) = if quick { (20_000, 5, 200, 2) } else { (20_000, 20, 1000, 3) };
     let mut rotor = RotorDownwash::bell47(0.68);
     let mut rng = seeded(2025, 1);
     let r0 = rotor.radius_m;
@@ -245,15 +249,24 @@ pub fn rotor_bench(quick: bool) -> Result<Vec<String>, FieldError> {
             Vec3::new(r * a.cos(), r * a.sin(), 0.01 + (rotor.hub_m.z - 0.01) * rng.random::<f64>())
         })
         .collect();
-    let (mean, _) = rotor_rate(&rotor, &starts, steps)?;
-    rotor.tip_vortices = true;
-    let (table, build) = rotor_rate(&rotor, &starts, steps)?;
-    let nodes = rotor.tabulated_vortices().map(|t| (t.nodes(), t.bytes())).unwrap_or((0, 0));
+    let mut vortices = rotor.clone();
+    vortices.tip_vortices = true;
+    let (mut mean, mut table, mut build) = (0.0f64, 0.0f64, None);
+    for _ in 0..ROTOR_ROUNDS {
+        mean = mean.max(rotor_rate(&rotor, &starts, steps)?.0);
+        let (rate, setup) = rotor_rate(&vortices, &starts, steps)?;
+        table = table.max(rate);
+        // The first round builds the table; later rounds find it built.
+        build.get_or_insert(setup);
+    }
+    let build = build.unwrap_or(0.0);
+    let nodes = vortices.tabulated_vortices().map(|t| (t.nodes(), t.bytes())).unwrap_or((0, 0));
+    rotor = vortices;
     rotor.vortex_table = false;
     let (direct, _) = rotor_rate(&rotor, &starts[..n_direct], steps_direct)?;
     Ok(vec![
         format!(
-            "track rotor: Bell 47 at z_d/R = 0.68, {n} parcels of 20 µm sand, dt = 1 ms, 1 thread, parcel-steps per CPU-second:"
+            "track rotor: Bell 47 at z_d/R = 0.68, {n} parcels of 20 µm sand, dt = 1 ms, {steps} steps, 1 thread, parcel-steps per CPU-second (fastest of {ROTOR_ROUNDS} alternating rounds):"
         ),
         format!("track rotor: mean flow                         {mean:.3e} parcel-steps per CPU-second"),
         format!(
@@ -268,6 +281,9 @@ pub fn rotor_bench(quick: bool) -> Result<Vec<String>, FieldError> {
         ),
     ])
 }
+
+/// Alternating timing rounds of the rotor benchmark's mean flow and tabulated vortices.
+const ROTOR_ROUNDS: usize = 3;
 
 #[cfg(test)]
 mod tests {

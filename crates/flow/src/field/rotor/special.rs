@@ -138,7 +138,8 @@ const EULER_GAMMA: f64 = 0.577_215_664_901_532_9;
 fn table_lookup(table: &[f64], t: f64) -> f64 {
     let n = table.len();
     let f = t * (n - 1) as f64;
-    let i = (f.floor() as isize).clamp(1, n as isize - 3) as usize;
+    // Truncation equals `floor` after the clamp to ≥ 1 (they differ only for negative f).
+    let i = (f as isize).clamp(1, n as isize - 3) as usize;
     let s = f - i as f64;
     let (a, b, c, d) = (s + 1.0, s, s - 1.0, s - 2.0);
     let w = [-b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0];

@@ -31,9 +31,11 @@
 //! Outside the tables' box the direct sum is used. The test `table_equals_direct_sum_*` bounds the
 //! difference to the direct sum (see [`TABLE_TOLERANCE`]).
 
-use super::rings::{ring_velocity_two_cores, Ring, VortexPath};
+use super::rings::{ring_core_difference, Ring, VortexPath};
 use super::RotorDownwash;
 use rayon::prelude::*;
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Grid spacing of the smooth table in units of the smoothing radius R_s.
 const SPACING_PER_SMOOTHING: f64 = 1.0 / 6.0;
@@ -99,6 +101,8 @@ impl Grid {
 /// The tabulated tip-vortex fluctuation of one rotor.
 #[derive(Clone, Debug)]
 pub struct VortexTable {
+    /// Identifies the table (and its clones) in the per-thread ring cache.
+    id: u64,
     /// The rotor the table was built for (compared against the rotor in use).
     pub source: RotorDownwash,
     pub path: VortexPath,
@@ -126,7 +130,9 @@ fn lagrange4(t: f64) -> [f64; 4] {
 /// First stencil node and the local coordinate for a point at grid coordinate `f` on `n` nodes.
 #[inline]
 fn stencil(f: f64, n: usize) -> (usize, f64) {
-    let i = (f.floor() as isize).clamp(1, n as isize - 3) as usize;
+    // Truncation instead of `floor` (a library call on the baseline x86-64 target): they differ only for
+    // negative non-integral f, where both are clamped to 1.
+    let i = (f as isize).clamp(1, n as isize - 3) as usize;
     (i - 1, f - i as f64)
 }
 
@@ -189,7 +195,9 @@ impl VortexTable {
         }
         let smooth = Self::build_smooth(&path, &segments, planes, smooth_grid, smoothing);
         let core_mean = Self::build_core_mean(&path, core_grid, smoothing, reach, rc_min);
+        static NEXT_ID: AtomicU64 = AtomicU64::new(0);
         Some(VortexTable {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
             source: rotor.clone(),
             path,
             smoothing,
@@ -290,8 +298,7 @@ impl VortexTable {
                                 return (0.0, 0.0);
                             }
                             let zv = image_of.map_or(ring.z, |zg| 2.0 * zg - ring.z);
-                            let (e, w) = ring_velocity_two_cores(gamma, ring.r, zv, ring.rc, smoothing, r, z);
-                            (e.0 - w.0, e.1 - w.1)
+                            ring_core_difference(gamma, ring.r, zv, ring.rc, smoothing, r, z)
                         });
                         acc.0 += a;
                         acc.1 += b;
@@ -328,7 +335,8 @@ impl VortexTable {
     fn smooth_part(&self, s: &Segment, phi: f64, r: f64, z: f64) -> (f64, f64) {
         let g = &self.smooth_grid;
         let fp = (phi - s.phi0) / (s.phi1 - s.phi0) * (s.nodes - 1) as f64;
-        let k = (fp.floor().max(0.0) as usize).min(s.nodes - 2);
+        // Truncation equals `floor` for fp ≥ 0; negative fp gives 0 either way.
+        let k = (fp.max(0.0) as usize).min(s.nodes - 2);
         let wp = (fp - k as f64).clamp(0.0, 1.0);
         let (i0, j0, wr, wz) = g.stencil(r, z);
         let plane_len = g.nr * g.nz;
@@ -387,33 +395,84 @@ impl VortexTable {
         let (c, d) = self.core_part(r, z);
         let (mut ur, mut uz) = (a - c, b - d);
         let reach2 = self.reach * self.reach;
-        // Physical rings (−Γ at z_v) near (r, z); ground images (+Γ at 2z_g − z_v) are near (r, z) when
-        // the ring is near the mirrored point (r, 2z_g − z).
-        let mut add = |gamma: f64, zq: f64, image_of: Option<f64>| {
-            for (lo, hi) in path.candidates(phi, count, r, zq, self.reach) {
-                for j in lo..=hi {
-                    let ring = path.ring(phi + j as f64 * path.period);
-                    if ring.rc >= self.smoothing {
-                        continue;
+        with_phase_rings(self.id, path, phi, count, |rings| {
+            // Physical rings (−Γ at z_v) near (r, z); ground images (+Γ at 2z_g − z_v) are near (r, z)
+            // when the ring is near the mirrored point (r, 2z_g − z).
+            let mut add = |gamma: f64, zq: f64, image_of: Option<f64>| {
+                for (lo, hi) in path.candidates(phi, count, r, zq, self.reach) {
+                    for ring in rings.get(lo..=hi).unwrap_or_default() {
+                        if ring.rc >= self.smoothing {
+                            continue;
+                        }
+                        let q = (r - ring.r) * (r - ring.r) + (zq - ring.z) * (zq - ring.z);
+                        if q > reach2 {
+                            continue;
+                        }
+                        let zv = image_of.map_or(ring.z, |zg| 2.0 * zg - ring.z);
+                        let (a, b) = ring_core_difference(gamma, ring.r, zv, ring.rc, self.smoothing, r, z);
+                        ur += a;
+                        uz += b;
                     }
-                    let q = (r - ring.r) * (r - ring.r) + (zq - ring.z) * (zq - ring.z);
-                    if q > reach2 {
-                        continue;
-                    }
-                    let zv = image_of.map_or(ring.z, |zg| 2.0 * zg - ring.z);
-                    let (exact, wide) =
-                        ring_velocity_two_cores(gamma, ring.r, zv, ring.rc, self.smoothing, r, z);
-                    ur += exact.0 - wide.0;
-                    uz += exact.1 - wide.1;
+                }
+            };
+            add(-path.gamma, z, None);
+            if let Some(zg) = path.ground_z {
+                add(path.gamma, 2.0 * zg - z, Some(zg));
+            }
+        });
+        (ur, uz)
+    }
+}
+
+/// The rings alive at one phase of one table.
+struct PhaseRings {
+    table: u64,
+    phi_bits: u64,
+    rings: Vec<Ring>,
+}
+
+/// Phases remembered per thread: a tracker step samples the field at one time, and its time derivative
+/// at two more.
+const CACHED_PHASES: usize = 4;
+
+thread_local! {
+    /// The last [`CACHED_PHASES`] ring sets of this thread and the slot to replace next.
+    static PHASE_RINGS: RefCell<(Vec<PhaseRings>, usize)> = const { RefCell::new((Vec::new(), 0)) };
+}
+
+/// Calls `f` with the rings j = 0..`count` (ages φ + jP) of `path` at phase `phi`. Every parcel of a
+/// tracker step is evaluated at the same time, so the rings' positions and cores (three square roots
+/// each) are computed once per thread and phase instead of once per candidate ring and point; the
+/// values are the same as [`VortexPath::ring`]'s, so results do not depend on the cache.
+fn with_phase_rings<R>(
+    table: u64,
+    path: &VortexPath,
+    phi: f64,
+    count: usize,
+    f: impl FnOnce(&[Ring]) -> R,
+) -> R {
+    PHASE_RINGS.with(|cell| {
+        let mut guard = cell.borrow_mut();
+        let (entries, next) = &mut *guard;
+        let phi_bits = phi.to_bits();
+        let slot = match entries.iter().position(|e| e.table == table && e.phi_bits == phi_bits) {
+            Some(k) => k,
+            None => {
+                let rings = (0..count).map(|j| path.ring(phi + j as f64 * path.period)).collect();
+                let entry = PhaseRings { table, phi_bits, rings };
+                if entries.len() < CACHED_PHASES {
+                    entries.push(entry);
+                    entries.len() - 1
+                } else {
+                    let k = *next;
+                    *next = (k + 1) % CACHED_PHASES;
+                    entries[k] = entry;
+                    k
                 }
             }
         };
-        add(-path.gamma, z, None);
-        if let Some(zg) = path.ground_z {
-            add(path.gamma, 2.0 * zg - z, Some(zg));
-        }
-        (ur, uz)
-    }
+        f(&entries[slot].rings)
+    })
 }
 
 #[cfg(test)]
