@@ -470,7 +470,7 @@ fn run_on<F: FlowField, M: FlowField>(
             gust: lo.gust_factor,
             fluid: air,
         }
-        .tabulate(b.duration_s, BED_FLOW_INTERVAL_S, phases == 1)
+        .tabulate(b.duration_s, BED_FLOW_INTERVAL_S, window.span <= 0.0)
     });
     let mut sim = CloudSim::new(field, model, settings, source);
     let mut grid = CloudGrid::new(domain, cfg.output.grid_cells);

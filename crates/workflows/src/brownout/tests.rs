@@ -411,6 +411,38 @@ fn bad_model_scales_are_named_by_key() {
 /// friction velocity at the start, not zeros), the rows stop when the patch's time ends (one row at its
 /// end, between two output times), and the times increase.
 #[test]
+fn the_dem_bed_feels_an_unsteady_flow_even_with_one_source_phase() {
+    // The source's phase count (how many times per period its flux is averaged) must not make the bed's
+    // flow steady: with tip vortices the friction velocity over the patch changes within 7 ms (a tenth of
+    // the shedding period 2π/(2 · 35.6 rad/s) = 88 ms).
+    let mut cfg = bell47();
+    cfg.rotor.tip_vortices = true;
+    cfg.entrainment.phases = 1;
+    cfg.entrainment.source = EntrainmentSource::DemBed;
+    cfg.dem_bed = Some(DemBedConfig {
+        grain_diameter_m: Some(300e-6),
+        patch_size_m: [7.4 * 300e-6, 5.0 * 300e-6],
+        layers: 2,
+        settle_s: Some(2e-3),
+        duration_s: 0.007,
+        ..DemBedConfig::default()
+    });
+    cfg.cloud.dt_s = 2e-3;
+    cfg.cloud.duration_s = 0.01;
+    cfg.output.interval_s = 0.004;
+    Checker::run(&cfg, None).unwrap();
+    let root = tempfile::tempdir().unwrap();
+    let d = RunDir::create(root.path()).unwrap();
+    run(&cfg, &RunContext::new(&d, &Unattended, false)).unwrap();
+    let rows = csv(&d.path("dem_bed_entrainment.csv"));
+    let u: Vec<f64> = rows.iter().map(|r| r[5]).collect();
+    assert!(u.iter().all(|&x| x > 0.0), "{u:?}");
+    let spread =
+        u.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - u.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(spread > 1e-4 * u[0], "the friction velocity over the patch must follow the vortices: {u:?}");
+}
+
+#[test]
 fn the_dem_bed_table_starts_with_the_flow_and_ends_with_the_patch() {
     let mut cfg = bell47();
     cfg.entrainment.source = EntrainmentSource::DemBed;
