@@ -42,6 +42,8 @@ pub struct Peer {
 pub enum RcbError {
     #[error("{ranks} ranks for {points} particles: every rank needs at least one particle; use at most {points} ranks")]
     TooManyRanks { ranks: usize, points: usize },
+    #[error("no particles to split over {ranks} ranks: start the run without mpirun")]
+    NoParticles { ranks: usize },
     #[error("a run needs at least one rank")]
     NoRanks,
     #[error("{points} particles on {ranks} ranks cannot be split: they share one position along every axis")]
@@ -61,6 +63,9 @@ impl Rcb {
     ) -> Result<Self, RcbError> {
         if ranks == 0 {
             return Err(RcbError::NoRanks);
+        }
+        if points.is_empty() && ranks > 1 {
+            return Err(RcbError::NoParticles { ranks });
         }
         if points.len() < ranks {
             return Err(RcbError::TooManyRanks { ranks, points: points.len() });
@@ -359,6 +364,8 @@ mod tests {
             "8 ranks for 5 particles: every rank needs at least one particle; use at most 5 ranks"
         );
         assert_eq!(Rcb::from_points(&pts, 0, domain(), [false; 3]), Err(RcbError::NoRanks));
+        let e = Rcb::from_points(&[], 2, domain(), [false; 3]).unwrap_err();
+        assert_eq!(e.to_string(), "no particles to split over 2 ranks: start the run without mpirun");
         let same = vec![Vec3::ONE; 4];
         assert!(matches!(
             Rcb::from_points(&same, 2, domain(), [false; 3]),

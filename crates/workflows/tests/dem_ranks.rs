@@ -261,7 +261,8 @@ fn pile_resumes_on_another_rank_count() {
         copy_dir(&dir(&format!("{from}_stopped")), &resumed);
         let done = on_ranks_with(&cfg, &resumed, ranks, (true, true), || Box::new(Unattended));
         assert!(done.iter().all(|f| *f == Ok(Finished::Completed)), "{from} on {ranks}: {done:?}");
-        assert!(!resumed.join("checkpoint.bin").exists(), "the finished run removed its checkpoint");
+        let parts = resumed.join("checkpoint");
+        assert!(!resumed.join("checkpoint.bin").exists() && !parts.exists(), "the checkpoint is removed");
         let ids = last_ids(&resumed);
         assert_eq!(ids, (0..n).collect::<Vec<i64>>(), "{from} on {ranks}: every id once");
         for column in ["kinetic_J", "potential_J", "total_J"] {

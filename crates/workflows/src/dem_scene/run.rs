@@ -919,12 +919,10 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     }
     out.flush()?;
     write_events(cfg, &sim, &events, ctx)?;
-    if ranks {
-        if root {
-            spatter_io::rank_checkpoint::remove(dir.root()).map_err(io(&dir.checkpoint_path()))?;
-        }
-    } else {
-        let _ = std::fs::remove_file(dir.checkpoint_path());
+    // The checkpoint is of no more use: `checkpoint.bin` and, when ranks wrote it (also a checkpoint of
+    // several ranks continued on one), its parts.
+    if root {
+        spatter_io::rank_checkpoint::remove(dir.root()).map_err(io(&dir.checkpoint_path()))?;
     }
     // Totals over the ranks (collective), then rank 0 holds the whole mesh records.
     let totals = Totals {
