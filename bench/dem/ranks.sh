@@ -31,7 +31,8 @@ else
 fi
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-duration="$(awk -v n="$steps" 'BEGIN {printf "%.10g", n * 5e-5}')"
+dt="$(awk -F' = ' '/^dt_s/ {print $2}' examples/dem_pile.toml)"
+duration="$(awk -v n="$steps" -v dt="$dt" 'BEGIN {printf "%.10g", n * dt}')"
 # The example in a box of lx × 0.24 m with the lattice 0.12 m high, one output at
 # the start and one at the end.
 scene() {

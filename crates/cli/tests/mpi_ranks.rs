@@ -301,7 +301,7 @@ fn dem_hopper_on_two_ranks_matches_one_rank() {
     }
 }
 
-/// The command line of `examples/dem_pile.toml` (507 grains settling in a box, 800 steps) into `out` with
+/// The command line of `examples/dem_pile.toml` (507 grains settling in a box, 4 000 steps) into `out` with
 /// `extra` arguments.
 fn dem_pile(out: &Path, extra: &[&str]) -> Vec<String> {
     let scenario = example("dem_pile.toml");
@@ -370,7 +370,7 @@ fn energy_difference(a: &Path, b: &Path, name: &str) -> f64 {
     ra.iter().zip(&rb).map(|(x, y)| (x[k] - y[k]).abs() / scale).fold(0.0, f64::max)
 }
 
-/// `examples/dem_pile.toml` stopped after 500 of its 800 steps under `mpirun -n 2` and resumed with
+/// `examples/dem_pile.toml` stopped after 2 500 of its 4 000 steps under `mpirun -n 2` and resumed with
 /// `--repartition` on 1 and on 2 ranks, and stopped as a plain (one-rank) run and resumed on 2 ranks.
 /// Without `--repartition` another rank count is refused on rank 0 with one sentence naming both counts,
 /// and nothing changes. Each resumed run ends with every id once, every `energy.csv` row has the step and
@@ -386,7 +386,7 @@ fn dem_pile_resumes_on_another_rank_count() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = plain(&strs(&dem_pile(&d("whole1"), &[])));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stop = [("SPATTER_STOP_AFTER_POLLS", "500")];
+    let stop = [("SPATTER_STOP_AFTER_POLLS", "2500")];
     let o = mpirun_env(2, &strs(&dem_pile(&d("two"), &[])), &stop);
     assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
     let o = Command::new(env!("CARGO_BIN_EXE_spatter"))
@@ -434,8 +434,8 @@ fn dem_pile_resumes_on_another_rank_count() {
 /// run is the same state with the same contact history; it differs from the uninterrupted one only in
 /// the order in which a particle's forces are added (the lists are rebuilt at the resume, the rank count
 /// changes), that is by round-off of 10⁻¹⁶ relative, which the collapse of the packing amplifies over the
-/// 300 steps after the resume (measured: 10⁻¹³ for the kinetic energy, 2·10⁻¹⁵ for the potential energy
-/// and the centre of mass, the budget total identical). A lost contact history moves grains by some
+/// 1 500 steps after the resume (measured: 5·10⁻¹⁴ for the kinetic energy, 3·10⁻¹⁵ for the potential
+/// energy, 1.4·10⁻¹⁵ for the centre of mass, 10⁻¹⁶ for the budget total). A lost contact history moves grains by some
 /// 10⁻⁷ m within 200 steps (`crates/dem/tests/decomposed.rs`), 10⁻⁵ of the fill height, and the energy
 /// accounts of a rank lost or counted twice shift the total by their whole size: 10⁻⁹ lies far above the
 /// round-off and far below both.

@@ -177,7 +177,7 @@ fn two_ranks_resume_bit_for_bit() {
 
 /// The settling pile of `examples/dem_pile.toml`: 507 grains (5–6 mm) on a face-centred cubic lattice
 /// (6 mm between neighbours) in a 6 cm box of planes, released at rest; they collapse onto the floor and each other (friction 0.5, restitution
-/// 0.4) over the 0.04 s (800 steps) of the run.
+/// 0.4) over the 0.04 s (4 000 steps) of the run.
 fn pile() -> SceneConfig {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let text = std::fs::read_to_string(root.join("dem_pile.toml")).unwrap();
@@ -231,7 +231,7 @@ fn last_ids(dir: &Path) -> Vec<i64> {
     ids
 }
 
-/// The settling pile stopped after 500 of its 800 steps on 2 thread-ranks and resumed with
+/// The settling pile stopped after 2 500 of its 4 000 steps on 2 thread-ranks and resumed with
 /// `--repartition` on 1 and on 2 ranks, and stopped on 1 rank and resumed on 2: every `energy.csv` row
 /// has the uninterrupted run's step and particle count, the last output holds every id once, and the
 /// kinetic energy, the potential energy (the height of the centre of mass) and the budget total stay within
@@ -248,7 +248,7 @@ fn pile_resumes_on_another_rank_count() {
         let done = on_ranks(&cfg, &dir(name), ranks, false, || Box::new(Unattended));
         assert!(done.iter().all(|f| *f == Ok(Finished::Completed)), "{done:?}");
         let stopped = on_ranks(&cfg, &dir(&format!("{name}_stopped")), ranks, false, || {
-            Box::new(StopAfterPolls::new(500))
+            Box::new(StopAfterPolls::new(2500))
         });
         assert!(stopped.iter().all(|f| *f == Ok(Finished::Interrupted)), "{stopped:?}");
     }
