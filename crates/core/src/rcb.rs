@@ -42,6 +42,8 @@ pub struct Peer {
 pub enum RcbError {
     #[error("{ranks} ranks for {points} particles: every rank needs at least one particle; use at most {points} ranks")]
     TooManyRanks { ranks: usize, points: usize },
+    #[error("no particles to split over {ranks} ranks: start the run without mpirun")]
+    NoParticles { ranks: usize },
     #[error("a run needs at least one rank")]
     NoRanks,
     #[error("{points} particles on {ranks} ranks cannot be split: they share one position along every axis")]
@@ -61,6 +63,9 @@ impl Rcb {
     ) -> Result<Self, RcbError> {
         if ranks == 0 {
             return Err(RcbError::NoRanks);
+        }
+        if points.is_empty() && ranks > 1 {
+            return Err(RcbError::NoParticles { ranks });
         }
         if points.len() < ranks {
             return Err(RcbError::TooManyRanks { ranks, points: points.len() });
@@ -185,12 +190,15 @@ impl Rcb {
                 &[0.0]
             }
         };
+        // The shift along a non-periodic axis is exactly 0, never `0 × length`: the domain may be
+        // unbounded there, and 0 × ∞ is NaN.
+        let component = |axis: usize, step: f64| if self.periodic[axis] { step * len[axis] } else { 0.0 };
         let mut out = Vec::new();
         for (rank, other) in boxes.iter().enumerate() {
             for &sx in steps(0) {
                 for &sy in steps(1) {
                     for &sz in steps(2) {
-                        let shift = Vec3::new(sx * len.x, sy * len.y, sz * len.z);
+                        let shift = Vec3::new(component(0, sx), component(1, sy), component(2, sz));
                         if rank == me && shift == Vec3::ZERO {
                             continue;
                         }
@@ -315,6 +323,37 @@ mod tests {
         }
     }
 
+    /// A domain unbounded along a non-periodic axis (a DEM scene without `domain_min_m`/`domain_max_m`
+    /// along it): no rank lists itself as its own peer, every shift is finite, and two ranks far apart
+    /// along the cut axis are not peers. Before the non-periodic shift was made exactly 0, its component
+    /// was 0 × ∞ = NaN, so every rank saw itself with a NaN shift and every other rank at gap 0.
+    #[test]
+    fn peers_of_an_unbounded_domain_have_finite_shifts() {
+        let pts = lattice();
+        let open = Aabb::new(Vec3::splat(f64::NEG_INFINITY), Vec3::splat(f64::INFINITY));
+        let half_open =
+            Aabb::new(Vec3::new(0.0, f64::NEG_INFINITY, 0.0), Vec3::new(20.0, f64::INFINITY, 6.0));
+        for (domain, periodic) in [(open, [false; 3]), (half_open, [true, false, false])] {
+            for ranks in 1..=4 {
+                let rcb = Rcb::from_points(&pts, ranks, domain, periodic).unwrap();
+                for me in 0..ranks {
+                    for p in rcb.peers(me, 1.5) {
+                        assert!(p.shift.is_finite(), "{ranks} ranks {periodic:?}: {me} sees {p:?}");
+                        assert!(p.rank != me || p.shift != Vec3::ZERO, "{me} is its own peer");
+                        assert!(p.rank != me || periodic[0], "{me} sees itself without a periodic axis");
+                    }
+                }
+            }
+        }
+        // Four ranks on the 20-long lattice cut x at 10 first, then the halves along x again (at 5 and
+        // 15): ranks 0 (x < 5) and 3 (x ≥ 15) are 10 apart and no peers for a width of 1.5.
+        let four = Rcb::from_points(&pts, 4, open, [false; 3]).unwrap();
+        let boxes = four.boxes();
+        assert_eq!((boxes[0].max.x, boxes[3].min.x), (5.0, 15.0));
+        assert!(four.peers(0, 1.5).iter().all(|p| p.rank != 3));
+        assert_eq!(four.peers(0, 1.5), vec![Peer { rank: 1, shift: Vec3::ZERO }]);
+    }
+
     #[test]
     fn bad_requests_are_refused_with_a_sentence() {
         let pts = lattice();
@@ -325,6 +364,8 @@ mod tests {
             "8 ranks for 5 particles: every rank needs at least one particle; use at most 5 ranks"
         );
         assert_eq!(Rcb::from_points(&pts, 0, domain(), [false; 3]), Err(RcbError::NoRanks));
+        let e = Rcb::from_points(&[], 2, domain(), [false; 3]).unwrap_err();
+        assert_eq!(e.to_string(), "no particles to split over 2 ranks: start the run without mpirun");
         let same = vec![Vec3::ONE; 4];
         assert!(matches!(
             Rcb::from_points(&same, 2, domain(), [false; 3]),

@@ -230,6 +230,41 @@ impl Particles {
         filter(&mut self.body, &mask);
     }
 
+    /// Appends every particle of `other` (ids kept; the next id is the larger of the two). The optional
+    /// arrays (external force and torque, body index) are kept when either store has them, with zero
+    /// or [`NO_BODY`] for the particles that had none.
+    pub fn append(&mut self, mut other: Particles) {
+        let (n, m) = (self.len(), other.len());
+        if !self.ext_force.is_empty() || !other.ext_force.is_empty() {
+            self.external_force_mut();
+            other.external_force_mut();
+        }
+        if !self.body.is_empty() || !other.body.is_empty() {
+            self.body.resize(n, NO_BODY);
+            other.body.resize(m, NO_BODY);
+        }
+        self.id.append(&mut other.id);
+        self.material.append(&mut other.material);
+        self.pos.append(&mut other.pos);
+        self.vel.append(&mut other.vel);
+        self.omega.append(&mut other.omega);
+        self.radius.append(&mut other.radius);
+        self.inv_mass.append(&mut other.inv_mass);
+        self.force.append(&mut other.force);
+        self.torque.append(&mut other.torque);
+        self.ext_force.append(&mut other.ext_force);
+        self.ext_torque.append(&mut other.ext_torque);
+        self.body.append(&mut other.body);
+        self.next_id = self.next_id.max(other.next_id);
+    }
+
+    /// Sorts the particles by id.
+    pub fn sort_by_id(&mut self) {
+        let mut perm: Vec<u32> = (0..self.len() as u32).collect();
+        perm.sort_unstable_by_key(|&k| self.id[k as usize]);
+        self.permute(&perm, &mut PermuteScratch::default());
+    }
+
     /// Bytes of particle state per particle (for memory reports).
     pub fn bytes_per_particle(&self) -> usize {
         let ext = if self.ext_force.is_empty() { 0 } else { 48 };

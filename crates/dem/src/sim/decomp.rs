@@ -207,8 +207,9 @@ impl<L: ContactLaw> Simulation<L> {
     /// Splits the particles (every rank holds the same set) over the ranks of `comm`: each rank keeps
     /// those in its box. Does nothing on one rank or when already split. Refuses, on every rank alike,
     /// what runs on one rank only (clumps, multi-step and implicit integrators) and more ranks than
-    /// particles. Rank 0 keeps the energy accounts of the set-up, the others start theirs from zero, so
-    /// that the sums over ranks are the run's.
+    /// particles. Rank 0 keeps the energy accounts, the removal count and the mesh impact records of the
+    /// state it splits (the set-up, or a checkpoint joined by [`Self::join_parts`]); the others start
+    /// theirs from zero, so that the sums over ranks are the run's.
     pub fn decompose(&mut self, comm: &dyn Comm) -> Result<(), DemError> {
         let points = self.particles.pos.clone();
         self.decompose_over(comm, &points)
@@ -242,8 +243,17 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.wall_list = Default::default();
         self.st.needs_rebuild = true;
         if rank != 0 {
+            // The sums over the ranks stay the run's (at the start all but the accounts are zero; after
+            // a repartitioned resume the joined state holds the run's totals on every rank).
             self.st.energy = Default::default();
             self.st.removed = 0;
+            let last = &mut self.st.last;
+            (last.elastic, last.pair_contacts, last.wall_contacts) = (0.0, 0, 0);
+            for w in &mut self.walls {
+                if let crate::walls::WallShape::Mesh(m) = &mut w.shape {
+                    m.records = crate::walls::MeshRecords::new(m.records.impacts.len());
+                }
+            }
         }
         self.decomp = Some(Decomp {
             boxes: rcb.boxes(),
@@ -288,8 +298,8 @@ impl<L: ContactLaw> Simulation<L> {
     pub fn restore_rank_state(&mut self, rs: RankState<L::State>, comm: &dyn Comm) -> Result<(), DemError> {
         if rs.partition.ranks() != comm.size() {
             return Err(DemError::Resume(format!(
-                "the checkpoint was written on {} ranks, this run has {}; a DEM run resumes on as many ranks \
-                 as wrote its checkpoint in this version",
+                "the checkpoint was written on {} ranks, this run has {}; resume on as many ranks, or join \
+                 the parts and split them afresh (--repartition, Simulation::join_parts)",
                 rs.partition.ranks(),
                 comm.size()
             )));

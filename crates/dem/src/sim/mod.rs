@@ -22,12 +22,14 @@ mod forces;
 mod impacts;
 mod integrate;
 mod neighbors;
+mod repartition;
 mod schemes;
 
 pub use decomp::RankState;
 pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
+pub use repartition::CheckpointPart;
 pub use schemes::{SchemeHistory, Y as SchemeState};
 
 use crate::contact::{ContactLaw, PairProps, PairTable};
@@ -243,7 +245,7 @@ impl<S> Default for DynState<S> {
 }
 
 /// Everything that evolves during a run; see [`Simulation::state`].
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct SimState<S> {
     pub particles: Particles,
     pub dynamic: DynState<S>,

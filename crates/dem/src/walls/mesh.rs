@@ -73,6 +73,23 @@ impl MeshRecords {
         }
     }
 
+    /// Adds the records of `other` (of the same mesh) triangle by triangle: the records of the same
+    /// wall kept by several ranks, joined.
+    pub fn add(&mut self, other: &MeshRecords) {
+        for (a, b) in self.impacts.iter_mut().zip(&other.impacts) {
+            *a += b;
+        }
+        for (a, b) in [
+            (&mut self.normal_impulse, &other.normal_impulse),
+            (&mut self.tangential_impulse, &other.tangential_impulse),
+            (&mut self.impact_speed_sum, &other.impact_speed_sum),
+            (&mut self.impact_angle_sum, &other.impact_angle_sum),
+            (&mut self.eroded_mass, &other.eroded_mass),
+        ] {
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+        }
+    }
+
     /// Sizes the records added after older checkpoints were written.
     pub(crate) fn fill_missing(&mut self) {
         let n = self.impacts.len();

@@ -620,6 +620,51 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
     sim
 }
 
+/// Reads the checkpoint for a run on the ranks of `ctx.comm` (collective), restores the simulation from
+/// it and returns the rest of the scene's state (its `sim` field left empty). On as many ranks as wrote
+/// it, every rank takes its own part and the run continues bit for bit. With `--repartition` (or a
+/// one-rank checkpoint on several ranks, which needs it) the parts are joined in id order with their
+/// contact history ([`Simulation::join_parts`]; the scene's other state is that of rank 0, which holds
+/// the file offsets) and split afresh over this run's ranks by the same bisection as at the start.
+fn resume_sim<L: ContactLaw, P: StepPartner>(
+    cfg: &SceneConfig,
+    sim: &mut Simulation<L>,
+    ctx: &RunContext,
+) -> Result<Checkpoint<L::State, P::State>, DemError> {
+    let comm = ctx.comm;
+    let (ck, parts) = match ctx.load_checkpoint_parts::<Checkpoint<L::State, P::State>, RankPart<_, _>>()? {
+        Resumed::Mine(RankPart { mut scene, rank }) => {
+            sim.restore(std::mem::take(&mut scene.sim)).map_err(DemError::Resume)?;
+            match rank {
+                Some(rs) => sim.restore_rank_state(rs, comm)?,
+                None if comm.size() > 1 => {
+                    return Err(DemError::Resume("the checkpoint part holds no split over the ranks".into()))
+                }
+                None => {}
+            }
+            return Ok(scene);
+        }
+        Resumed::Whole(mut ck) => {
+            let state = std::mem::take(&mut ck.sim);
+            (ck, vec![(state, None)])
+        }
+        Resumed::All(parts) => {
+            let mut parts = parts.into_iter();
+            let Some(RankPart { scene: mut ck, rank }) = parts.next() else {
+                return Err(DemError::Resume("the checkpoint has no parts".into()));
+            };
+            let mut states = vec![(std::mem::take(&mut ck.sim), rank)];
+            states.extend(parts.map(|p| (p.scene.sim, p.rank)));
+            (ck, states)
+        }
+    };
+    sim.join_parts(parts)?;
+    if comm.size() > 1 {
+        sim.decompose_over(comm, &split_points(cfg, sim))?;
+    }
+    Ok(ck)
+}
+
 fn run_with<L: ContactLaw, P: StepPartner>(
     law: L,
     built: setup::Built,
@@ -664,31 +709,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     let mut probe = None;
     let probe_every = cfg.probe.as_ref().map_or(1, |p| super::probe::sample_every(p, cfg.dt_s));
     if ctx.resume {
-        let (ck, rank_state) = if ranks {
-            match ctx.load_checkpoint_parts::<(), RankPart<L::State, P::State>>().map_err(DemError::from)? {
-                Resumed::Mine(part) => (part.scene, part.rank),
-                Resumed::Whole(()) | Resumed::All(_) => {
-                    return Err(DemError::Resume(format!(
-                    "a DEM run resumes on as many ranks as wrote its checkpoint in this version (this run \
-                         has {}; --repartition is for the sph kind)",
-                    comm.size()
-                ))
-                    .into())
-                }
-            }
-        } else {
-            (ctx.load_checkpoint().map_err(DemError::from)?, None)
-        };
-        sim.restore(ck.sim).map_err(DemError::Resume)?;
-        match rank_state {
-            Some(rs) => sim.restore_rank_state(rs, comm)?,
-            None if ranks => {
-                return Err(
-                    DemError::Resume("the checkpoint part holds no split over the ranks".into()).into()
-                )
-            }
-            None => {}
-        }
+        let ck = resume_sim::<L, P>(cfg, &mut sim, ctx)?;
         partner.restore(ck.partner, ctx, sim.time())?;
         if ck.injectors.len() != injectors.len() {
             return Err(DemError::Resume("the number of injectors changed".into()).into());
@@ -898,12 +919,10 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     }
     out.flush()?;
     write_events(cfg, &sim, &events, ctx)?;
-    if ranks {
-        if root {
-            spatter_io::rank_checkpoint::remove(dir.root()).map_err(io(&dir.checkpoint_path()))?;
-        }
-    } else {
-        let _ = std::fs::remove_file(dir.checkpoint_path());
+    // The checkpoint is of no more use: `checkpoint.bin` and, when ranks wrote it (also a checkpoint of
+    // several ranks continued on one), its parts.
+    if root {
+        spatter_io::rank_checkpoint::remove(dir.root()).map_err(io(&dir.checkpoint_path()))?;
     }
     // Totals over the ranks (collective), then rank 0 holds the whole mesh records.
     let totals = Totals {
