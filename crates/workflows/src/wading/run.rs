@@ -8,7 +8,7 @@ use super::geometry::{road_mesh, side_walls_mesh, write_stl};
 use super::parts::{bounds, read_parts, NamedPart};
 use super::path::VehiclePath;
 use super::timeline::{SpeedProfile, Travel};
-use super::vehicle::{check_wheels, check_width, place_on_road, Placement, WheelSpec};
+use super::vehicle::{check_wheels, check_width, front_wheel, place_along, wheelbase, Placement};
 use crate::sph_scene::config::{
     DomainConfig, FillConfig, FillType, HeightConfig, MotionConfig, MotionType, OutputConfig, SensorConfig,
     SphConfig, WallConfig, WallType,
@@ -118,7 +118,7 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
     let front = front_wheel(&cfg.vehicle.wheels);
     let r_front = front.map(|w| w.radius_m).unwrap_or(0.0);
     let (x_in, _) = cfg.channel.waterline();
-    let along = |speed| Travel::Along { x0: x_in - r_front - cfg.vehicle.start_gap_m, speed };
+    let along = |speed| Travel::Along { x0: x_in - r_front - cfg.vehicle.start_gap_m, y0: 0.0, speed };
     let m = &cfg.motion;
     let travel = match (&m.speed_m_s, &m.file, &m.path) {
         (Some(v), _, _) => along(SpeedProfile::constant(*v)),
@@ -127,10 +127,12 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
                 .map_err(|e| input("motion.file", format!("{}: {e}", f.display())))?;
             along(SpeedProfile::parse(&text, f).map_err(|e| input("motion.file", e))?)
         }
-        (None, None, Some(p)) => Travel::Path(read_path(p)?),
+        (None, None, Some(p)) => {
+            Travel::Path { path: read_path(p)?, wheelbase: wheelbase(&cfg.vehicle.wheels) }
+        }
         (None, None, None) => return Err(input("motion.speed_m_s", "give speed_m_s, file or [motion.path]")),
     };
-    let on_path = matches!(travel, Travel::Path(_));
+    let on_path = matches!(travel, Travel::Path { .. });
     let x_front0 = travel.front(0.0).0;
     let t_enter = travel.time_to_x(x_in - r_front).unwrap_or(0.0);
     let t_end = match cfg.output.end_time_s {
@@ -154,7 +156,7 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
             }
         })?,
     };
-    if let Travel::Path(p) = &travel {
+    if let Travel::Path { path: p, .. } = &travel {
         check_path(cfg, &parts, p, &travel, t_end)?;
     }
     let mut map_times = Vec::new();
@@ -211,7 +213,8 @@ fn check_path(
     let key = || if path.origin_at(0.0).starts_with("rows[") { "motion.path" } else { "motion.path.file" };
     for h in &path.heights {
         let (x, y) = travel.front(h.t);
-        let z = c.axle_height(x, y, r_front, travel.heading(h.t));
+        let heading = place_along(parts, wheels, c, travel, h.t).yaw;
+        let z = c.axle_height(x, y, r_front, heading);
         if (h.z - z).abs() > PATH_Z_TOLERANCE * r_front {
             return Err(input(
                 key(),
@@ -242,7 +245,8 @@ fn check_path(
     let n = (t_end / dt).ceil() as usize;
     for k in 0..=n {
         let t = (k as f64 * dt).min(t_end);
-        let heading = travel.heading(t);
+        let p = place_along(parts, wheels, c, travel, t);
+        let heading = p.yaw;
         if heading.cos() < 0.2 {
             return Err(input(
                 key(),
@@ -254,7 +258,6 @@ fn check_path(
                 ),
             ));
         }
-        let p = place_on_road(parts, wheels, c, travel.front(t), heading);
         for q in corners.iter().map(|&q| p.apply(q)) {
             let beyond = if q.y.abs() > half {
                 Some(format!(
@@ -280,10 +283,6 @@ fn check_path(
         }
     }
     Ok(())
-}
-
-fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
-    wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x))
 }
 
 /// Rows `t vx vy vz wx wy wz` of the body's motion about its rear axle (the placement's pivot, in the
@@ -327,9 +326,9 @@ fn wrap_angle(a: f64) -> f64 {
 /// Rows of a wheel's spin relative to the body: ω = v(t)/R about the axle (rolling without slip), the
 /// axle along the body's y axis as it was at t = 0 (heading ψ₀: (−sin ψ₀, cos ψ₀, 0)), the frame the body
 /// carries its wheels' tables in.
-fn wheel_table(plan: &Plan, radius: f64, dt: f64) -> String {
+fn wheel_table(plan: &Plan, yaw0: f64, radius: f64, dt: f64) -> String {
     let n = (plan.t_end / dt).ceil() as usize + 1;
-    let (sin0, cos0) = plan.travel.heading(0.0).sin_cos();
+    let (sin0, cos0) = yaw0.sin_cos();
     let mut s = String::from("# t_s vx vy vz wx wy wz: wheel spin relative to the body, omega = v/R\n");
     for k in 0..=n {
         let t = k as f64 * dt;
@@ -351,7 +350,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
     let c: &ChannelSpec = &cfg.channel;
     let dp = cfg.fluid.spacing_m;
     let wheels = &cfg.vehicle.wheels;
-    let place = |t: f64| place_on_road(&plan.parts, wheels, c, plan.travel.front(t), plan.travel.heading(t));
+    let place = |t: f64| place_along(&plan.parts, wheels, c, &plan.travel, t);
     let p0 = place(0.0);
     let pivot0 = p0.pivot + p0.shift;
     // Motion tables sampled every 2 cm of travel (at most 10 ms).
@@ -385,7 +384,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
             Some(w) => {
                 let name = format!("spin_{}", part.name);
                 let f = geo.join(format!("motion_{}.txt", part.name));
-                write_text(&f, &wheel_table(plan, w.radius_m, dt))?;
+                write_text(&f, &wheel_table(plan, p0.yaw, w.radius_m, dt))?;
                 motions.push(MotionConfig {
                     name: name.clone(),
                     parent: Some("body".into()),
@@ -698,7 +697,7 @@ mod tests {
     use super::*;
     use crate::wading::config::{MotionSpec, PathSpec, WadingOutput};
     use crate::wading::patches::SensorBox;
-    use crate::wading::vehicle::PartFile;
+    use crate::wading::vehicle::{place_on_road, PartFile};
     use spatter_core::mesh::TriMesh;
     use spatter_core::motion::{Motion, MotionTable};
 
@@ -908,12 +907,16 @@ mod tests {
         }
     }
 
-    /// The vehicle on an arc of radius 30 m at 2 m/s (ω = 1/15 rad/s, rows every 0.25 s over 3 s): the
-    /// integrated body motion keeps the front axle on the path (to 3 mm, the motion table's integration)
-    /// and turns the body with the path's tangent ω t (to 2 mrad), both axles on the road; each wheel
-    /// spins about the body's lateral axis at v/R (to 10⁻⁴: the table samples the speed every 2 cm).
+    /// The vehicle on an arc of radius ρ = 30 m at 2 m/s (ω = 1/15 rad/s, rows every 0.25 s over 3 s),
+    /// wheelbase L = 3 m: the integrated body motion keeps the front axle on the path (to 3 mm, the motion
+    /// table's integration) and, once the rear axle has driven onto the arc (t ≥ L/v = 1.5 s), the rear
+    /// axle's centre-line point on the same circle (to 3 mm); before that the rear axle is on the straight
+    /// line that continues the path backwards (y = −0.3 m). The body heading lags the tangent ω t by the
+    /// chord angle asin(L / 2ρ) = 0.05002 rad (geometry of a chord of length L in a circle of radius ρ; to
+    /// 2 mrad), both axles on the road; each wheel spins about the body's lateral axis at v/R (to 10⁻⁴:
+    /// the table samples the speed every 2 cm).
     #[test]
-    fn a_curved_path_turns_the_vehicle_with_its_tangent() {
+    fn on_a_curved_path_the_rear_axle_trails_the_front_on_the_path() {
         let dir = tempfile::tempdir().unwrap();
         let mut cfg = config(dir.path());
         let x0 = plan(&cfg).unwrap().x_front0;
@@ -929,7 +932,7 @@ mod tests {
         cfg.output.end_time_s = Some(3.0);
         let plan = plan(&cfg).unwrap();
         let scene = scene(&cfg, &plan, &dir.path().join("geometry")).unwrap();
-        let c = &cfg.channel;
+        let c = cfg.channel.clone();
         let load = |k: usize| {
             let m = &scene.motions[k];
             let text = std::fs::read_to_string(m.file.as_ref().unwrap()).unwrap();
@@ -938,27 +941,30 @@ mod tests {
         let mut tree = spatter_core::motion::KinematicTree::new();
         let body = tree.add(load(0), None);
         let spin = tree.add(load(1), Some(body));
-        let p0 = place_on_road(
-            &plan.parts,
-            &cfg.vehicle.wheels,
-            c,
-            plan.travel.front(0.0),
-            plan.travel.heading(0.0),
-        );
+        let p0 = place_along(&plan.parts, &cfg.vehicle.wheels, &c, &plan.travel, 0.0);
         let front0 = p0.apply(Vec3::new(3.0, 0.0, 2.4));
         let rear0 = p0.apply(Vec3::new(0.0, 0.0, 2.4));
         let axle0 = p0.apply(Vec3::new(3.0, 1.0, 2.4)) - p0.apply(Vec3::new(3.0, 0.0, 2.4));
+        let chord = (3.0 / (2.0 * r)).asin();
         for k in 0..30 {
             let t = 0.1 * k as f64;
             let f = tree.world_point(body, t, front0);
             let rr = tree.world_point(body, t, rear0);
             let (xp, yp) = (x0 + r * (w * t).sin(), -0.3 + r * (1.0 - (w * t).cos()));
             assert!((f.x - xp).hypot(f.y - yp) < 3e-3, "t = {t}: front axle {f} off the path ({xp}, {yp})");
+            if t >= 1.5 {
+                let off = (rr.x - x0).hypot(rr.y - (r - 0.3)) - r;
+                assert!(off.abs() < 3e-3, "t = {t}: rear axle {rr} {off} m off the circle");
+            } else {
+                assert!((rr.y + 0.3).abs() < 3e-3, "t = {t}: rear axle {rr} off the lead-in line");
+            }
             assert!((f.z - c.axle_z(f.x, 0.4)).abs() < 3e-3, "t = {t}: front axle {f} off the road");
             assert!((rr.z - c.axle_z(rr.x, 0.4)).abs() < 3e-3, "t = {t}: rear axle {rr} off the road");
             let fwd = f - rr;
             let heading = fwd.y.atan2(fwd.x);
-            assert!((heading - w * t).abs() < 2e-3, "t = {t}: body heading {heading} vs tangent {}", w * t);
+            if t >= 1.5 {
+                assert!((heading - (w * t - chord)).abs() < 2e-3, "t = {t}: body heading {heading}");
+            }
             // The wheel's own spin (its angular velocity less the body's) lies along the body's axle.
             let rel = tree.angular_velocity(spin, t) - tree.angular_velocity(body, t);
             let axle = tree.rotation(body, t) * axle0;
@@ -969,6 +975,34 @@ mod tests {
                 rel.length()
             );
             assert!((plan.travel.speed(t) - 2.0).abs() < 0.01);
+        }
+    }
+
+    /// On a straight path along x (off the centre line, y = 0.3 m, through the entry ramp) the trailing
+    /// rear axle changes nothing: every placement equals, bit for bit, the one headed along the path's
+    /// tangent (the model before the rear axle trailed).
+    #[test]
+    fn on_a_straight_path_the_trailing_rear_axle_changes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = config(dir.path());
+        let x0 = plan(&cfg).unwrap().x_front0;
+        cfg.motion = MotionSpec {
+            speed_m_s: None,
+            file: None,
+            path: Some(PathSpec {
+                file: None,
+                rows: Some(vec![vec![0.0, x0, 0.3], vec![1.0, x0 + 1.5, 0.3], vec![3.0, x0 + 6.5, 0.3]]),
+            }),
+        };
+        cfg.output.end_time_s = Some(3.0);
+        let plan = plan(&cfg).unwrap();
+        let Travel::Path { path, .. } = &plan.travel else { panic!("a path") };
+        let c = cfg.channel.clone();
+        for k in 0..=300 {
+            let t = 0.01 * k as f64;
+            let tangent = place_on_road(&plan.parts, &cfg.vehicle.wheels, &c, path.point(t), path.heading(t));
+            let trailing = place_along(&plan.parts, &cfg.vehicle.wheels, &c, &plan.travel, t);
+            assert_eq!(trailing, tangent, "t = {t}");
         }
     }
 
