@@ -1,7 +1,7 @@
 //! The vehicle: its part files, its wheels (found by part name, with axle and radius), checks that name
 //! the scenario key of every problem, and its placement on the channel's road.
 
-use super::channel::{pitch, ChannelSpec, Road};
+use super::channel::{pitch, Road};
 use super::parts::{bounds, wheel_reach, NamedPart};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Invalid;
@@ -96,16 +96,16 @@ pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
     errs
 }
 
-/// A vehicle as wide as the channel or wider, named under `channel.width_m`.
-pub fn check_width(parts: &[NamedPart], channel: &ChannelSpec) -> Option<Invalid> {
+/// A vehicle as wide as the channel or wider: `width` \[m\] across the channel, reported under `key`
+/// with `what` describing where the width comes from (`"width_m = 4 m"`).
+pub fn check_width(parts: &[NamedPart], width: f64, key: &str, what: &str) -> Option<Invalid> {
     let b = bounds(parts);
     let across = b.max.y - b.min.y;
-    (across >= channel.width_m).then(|| Invalid {
-        key: "channel.width_m".into(),
+    (across >= width).then(|| Invalid {
+        key: key.into(),
         message: format!(
-            "width_m = {} m is not wider than the vehicle ({across:.3} m across its parts): it would not fit between \
-             the walls",
-            channel.width_m
+            "{what} is not wider than the vehicle ({across:.3} m across its parts): it would not fit between the \
+             walls"
         ),
     })
 }
@@ -286,8 +286,8 @@ pub(crate) mod tests {
     }
 
     /// The shared test channel, lengthened to take the 4 m wheelbase.
-    fn channel() -> ChannelSpec {
-        ChannelSpec {
+    fn channel() -> crate::wading::channel::ChannelSpec {
+        crate::wading::channel::ChannelSpec {
             approach_length_m: 8.0,
             pool_length_m: 10.0,
             ..crate::wading::channel::tests::channel()
@@ -315,10 +315,8 @@ pub(crate) mod tests {
     #[test]
     fn a_vehicle_wider_than_the_channel_is_named() {
         let (parts, _) = truck();
-        let mut c = channel();
-        assert!(check_width(&parts, &c).is_none());
-        c.width_m = 2.2;
-        let e = check_width(&parts, &c).unwrap();
+        assert!(check_width(&parts, channel().width_m, "channel.width_m", "width_m = 4 m").is_none());
+        let e = check_width(&parts, 2.2, "channel.width_m", "width_m = 2.2 m").unwrap();
         assert_eq!(e.key, "channel.width_m");
         assert!(e.message.contains("2.300 m across"), "{}", e.message);
     }
