@@ -105,7 +105,7 @@ impl StlChannel {
                 return Err(ChannelFileError {
                     key: "water_depth_m",
                     message: format!(
-                        "water_depth_m = {water_depth} m puts the water surface at z = {water_z} m (above the road's \
+                        "water_depth_m = {water_depth} m puts the water surface at z = {water_z:.4} m (above the road's \
                          lowest point z = {floor_z} m), over the top of wall `{}` (z = {top} m) of {}: the water \
                          would run out; lower it or raise the wall",
                         p.name,
@@ -168,7 +168,7 @@ impl StlChannel {
             ChannelFileError {
             key: "water_depth_m",
             message: format!(
-                "water_depth_m = {depth} m puts the water surface at z = {} m, above the road at its {end} \
+                "water_depth_m = {depth} m puts the water surface at z = {:.4} m, above the road at its {end} \
                  (x = {x} m, z = {}) on the centre line y = {y} m of {}: the water would run out of the channel; \
                  lower it or make the road rise above the water at both ends",
                 self.water_z,

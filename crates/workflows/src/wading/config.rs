@@ -193,11 +193,12 @@ impl Validate for ChannelConfig {
                 None => {
                     for (key, v) in self.dimensions() {
                         if v.is_none() {
+                            // Reported on the table (the key itself is not in the file to point at).
                             c.fail(
-                                key,
+                                "",
                                 format!(
-                                    "missing: a generated channel needs {key} (see docs/wading.md), or give \
-                                     file = \"channel.stl\" for a channel read from an STL file"
+                                    "{key} is missing: a generated channel needs {key} (see docs/wading.md), \
+                                     or give file = \"channel.stl\" for a channel read from an STL file"
                                 ),
                             );
                         }

@@ -181,6 +181,7 @@ mod tests {
     use crate::wading::config::ChannelConfig;
     use crate::wading::run::{plan, scene, tests::config};
     use crate::wading::vehicle::place_along;
+    use spatter_core::check::Checker;
 
     /// The test scenario's channel (`run::tests::config`) as a file of its road and walls, at 0.1 m
     /// spacing (three layers of water 0.3 m deep).
@@ -256,5 +257,36 @@ mod tests {
             }
         }
         assert!(lowest > 100, "{lowest} particles on the floor");
+    }
+
+    /// `spatter check` (the scenario's validation) names every problem of a channel file by its key.
+    #[test]
+    fn check_names_bad_channel_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let (generated, from_file) = both(dir.path());
+        assert!(Checker::run(&from_file, None).is_ok());
+        let keys = |cfg: &crate::wading::WadingConfig| -> Vec<(String, String)> {
+            Checker::run(cfg, None).unwrap_err().into_iter().map(|e| (e.key, e.message)).collect()
+        };
+        let mut c = from_file.clone();
+        c.channel.water_depth_m = 0.6;
+        let e = keys(&c);
+        assert!(e[0].0 == "channel.water_depth_m" && e[0].1.contains("above the road at its start"), "{e:?}");
+        let mut c = from_file.clone();
+        c.channel.width_m = Some(3.0);
+        let e = keys(&c);
+        assert!(e[0].0 == "channel.width_m" && e[0].1.contains("remove it"), "{e:?}");
+        let mut c = from_file.clone();
+        c.vehicle.parts[0].scale = 2.0;
+        let e = keys(&c);
+        assert!(e[0].0 == "channel.file" && e[0].1.contains("is not wider than the vehicle"), "{e:?}");
+        let mut c = from_file.clone();
+        c.channel.file = Some(dir.path().join("none.stl"));
+        let e = keys(&c);
+        assert!(e[0].0 == "channel.file" && e[0].1.contains("no such file"), "{e:?}");
+        let mut c = generated.clone();
+        c.channel.ramp_length_m = None;
+        let e = keys(&c);
+        assert!(e[0].0 == "channel" && e[0].1.starts_with("ramp_length_m is missing"), "{e:?}");
     }
 }
