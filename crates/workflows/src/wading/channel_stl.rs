@@ -196,8 +196,8 @@ impl StlChannel {
             });
         };
         let above = |x: f64| self.road_z(x, y).is_none_or(|z| z >= self.water_z);
-        let x_in = bisect(xs[first - 1], xs[first], &above);
-        let x_out = bisect(xs[last + 1], xs[last], &above);
+        let x_in = bisect(xs[first - 1], xs[first], above);
+        let x_out = bisect(xs[last + 1], xs[last], above);
         let (k_deep, z_deep) = zs
             .iter()
             .enumerate()

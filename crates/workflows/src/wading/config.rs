@@ -398,7 +398,8 @@ impl WadingConfig {
         if let Some(f) = &channel.file {
             channel.file = Some(c.resolve(f));
         }
-        if parts.is_empty() || !(self.channel.water_depth_m > 0.0) {
+        let has_water = self.channel.water_depth_m > 0.0;
+        if parts.is_empty() || !has_water {
             return;
         }
         if let Ok(ch) = super::layout::Channel::new(&channel) {
