@@ -1,6 +1,7 @@
 //! The scenario file of kind `wading`: every key, its unit and default (documented in `docs/wading.md`).
 
 use super::channel::ChannelSpec;
+use super::channel_stl::StlChannel;
 use super::patches::SensorBox;
 use super::path::VehiclePath;
 use super::timeline::SpeedProfile;
@@ -58,7 +59,7 @@ pub struct WadingConfig {
     /// Air drag on the water, as in the `sph` kind; on by default (air at rest).
     #[serde(default = "d_drag")]
     pub drag: DragConfig,
-    pub channel: ChannelSpec,
+    pub channel: ChannelConfig,
     pub vehicle: VehicleConfig,
     pub motion: MotionSpec,
     /// Sensor patches: names of vehicle parts whose wet fraction is followed over time.
@@ -70,6 +71,142 @@ pub struct WadingConfig {
     pub sensor_boxes: Vec<SensorBox>,
     #[serde(default)]
     pub output: WadingOutput,
+}
+
+/// The `[channel]` table: a channel generated from its dimensions, or read from an STL file (`file`),
+/// both holding water `water_depth_m` deep. Every key is documented in `docs/wading.md`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelConfig {
+    /// A channel read from a multi-solid ASCII STL file (solids `road…` and walls) instead of generated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Flat road before the entry ramp \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach_length_m: Option<f64>,
+    /// Horizontal length of each ramp \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp_length_m: Option<f64>,
+    /// Length of the flat pool floor \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pool_length_m: Option<f64>,
+    /// Depth of the pool floor below the road \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pool_depth_m: Option<f64>,
+    /// Flat road after the exit ramp \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exit_length_m: Option<f64>,
+    /// Width between the side walls \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width_m: Option<f64>,
+    /// Height of the side walls above the road \[m\] (generated channel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_height_m: Option<f64>,
+    /// Water depth \[m\] (the study's `x`): over the pool floor of a generated channel, over the road's
+    /// lowest point of a channel from a file.
+    pub water_depth_m: f64,
+    /// Akinci adhesion factor of the road and the walls (needs surface tension). Default 1.
+    #[serde(default = "d_adhesion")]
+    pub adhesion: f64,
+}
+
+impl ChannelConfig {
+    /// The generated channel's keys as `(name, value)`.
+    fn dimensions(&self) -> [(&'static str, Option<f64>); 7] {
+        [
+            ("approach_length_m", self.approach_length_m),
+            ("ramp_length_m", self.ramp_length_m),
+            ("pool_length_m", self.pool_length_m),
+            ("pool_depth_m", self.pool_depth_m),
+            ("exit_length_m", self.exit_length_m),
+            ("width_m", self.width_m),
+            ("wall_height_m", self.wall_height_m),
+        ]
+    }
+
+    /// The generated channel, when `file` is not given and every dimension is.
+    pub fn generated(&self) -> Option<ChannelSpec> {
+        if self.file.is_some() {
+            return None;
+        }
+        Some(ChannelSpec {
+            approach_length_m: self.approach_length_m?,
+            ramp_length_m: self.ramp_length_m?,
+            pool_length_m: self.pool_length_m?,
+            pool_depth_m: self.pool_depth_m?,
+            exit_length_m: self.exit_length_m?,
+            width_m: self.width_m?,
+            wall_height_m: self.wall_height_m?,
+            water_depth_m: self.water_depth_m,
+            adhesion: self.adhesion,
+        })
+    }
+}
+
+impl From<ChannelSpec> for ChannelConfig {
+    fn from(c: ChannelSpec) -> Self {
+        ChannelConfig {
+            file: None,
+            approach_length_m: Some(c.approach_length_m),
+            ramp_length_m: Some(c.ramp_length_m),
+            pool_length_m: Some(c.pool_length_m),
+            pool_depth_m: Some(c.pool_depth_m),
+            exit_length_m: Some(c.exit_length_m),
+            width_m: Some(c.width_m),
+            wall_height_m: Some(c.wall_height_m),
+            water_depth_m: c.water_depth_m,
+            adhesion: c.adhesion,
+        }
+    }
+}
+
+impl Validate for ChannelConfig {
+    fn validate(&self, c: &mut Checker) {
+        match &self.file {
+            Some(file) => {
+                for (key, v) in self.dimensions() {
+                    if v.is_some() {
+                        c.fail(
+                            key,
+                            format!(
+                                "{key} is a dimension of a generated channel, but the channel comes from file = \
+                                 \"{}\"; remove it",
+                                file.display()
+                            ),
+                        );
+                    }
+                }
+                c.positive("water_depth_m", self.water_depth_m);
+                c.non_negative("adhesion", self.adhesion);
+                let full = c.resolve(file);
+                if !full.is_file() {
+                    return c.file_exists("file", file);
+                }
+                if self.water_depth_m > 0.0 {
+                    if let Err(e) = StlChannel::read(&full, self.water_depth_m) {
+                        c.fail(e.key, e.message);
+                    }
+                }
+            }
+            None => match self.generated() {
+                Some(g) => g.validate(c),
+                None => {
+                    for (key, v) in self.dimensions() {
+                        if v.is_none() {
+                            // Reported on the table (the key itself is not in the file to point at).
+                            c.fail(
+                                "",
+                                format!(
+                                    "{key} is missing: a generated channel needs {key} (see docs/wading.md), \
+                                     or give file = \"channel.stl\" for a channel read from an STL file"
+                                ),
+                            );
+                        }
+                    }
+                }
+            },
+        }
+    }
 }
 
 /// The vehicle: its part files, its wheels and the adhesion of its surfaces.
@@ -173,6 +310,7 @@ impl Validate for WadingConfig {
             c.finite_vec("air_velocity_m_s", self.drag.air_velocity_m_s);
         });
         c.item("channel", &self.channel);
+        self.check_vehicle_width(c);
         c.nested("vehicle", |c| {
             if self.vehicle.parts.is_empty() {
                 c.fail(
@@ -241,6 +379,33 @@ impl Validate for WadingConfig {
         });
         for (i, b) in self.sensor_boxes.iter().enumerate() {
             c.element("sensor_boxes", i, |c| b.validate(c));
+        }
+    }
+}
+
+impl WadingConfig {
+    /// A vehicle as wide as the channel or wider, when the part files and the channel read (their own
+    /// problems are reported by their keys).
+    fn check_vehicle_width(&self, c: &mut Checker) {
+        let mut parts = Vec::new();
+        for p in &self.vehicle.parts {
+            match super::parts::read_parts(&c.resolve(&p.file), p.scale) {
+                Ok(mut read) => parts.append(&mut read),
+                Err(_) => return,
+            }
+        }
+        let mut channel = self.channel.clone();
+        if let Some(f) = &channel.file {
+            channel.file = Some(c.resolve(f));
+        }
+        let has_water = self.channel.water_depth_m > 0.0;
+        if parts.is_empty() || !has_water {
+            return;
+        }
+        if let Ok(ch) = super::layout::Channel::new(&channel) {
+            if let Some(e) = ch.check_vehicle_width(&parts) {
+                c.fail(&e.key, e.message);
+            }
         }
     }
 }

@@ -10,8 +10,10 @@
 //! wheel spin ω = v/R), runs it and writes the wading reports.
 
 pub mod channel;
+pub mod channel_stl;
 pub mod config;
 pub mod geometry;
+pub mod layout;
 pub mod parts;
 pub mod patches;
 pub mod path;

@@ -137,12 +137,82 @@ impl VehiclePath {
         let (h00, h10, h01, h11) =
             (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, -2.0 * s3 + 3.0 * s2, s3 - s2);
         let c = |a: usize| {
+            // A coordinate that stays put over the segment is returned as it is (the cubic's weights sum
+            // to one only up to round-off), so a path along a line x or y = const stays exactly on it.
+            if self.xy[k][a] == self.xy[k + 1][a] && self.slopes[k][a] == 0.0 && self.slopes[k + 1][a] == 0.0
+            {
+                return self.xy[k][a];
+            }
             h00 * self.xy[k][a]
                 + h10 * h * self.slopes[k][a]
                 + h01 * self.xy[k + 1][a]
                 + h11 * h * self.slopes[k + 1][a]
         };
         (c(0), c(1))
+    }
+
+    /// The point `dist` \[m\] (straight-line, horizontal) behind the point at `t` along the way it came:
+    /// the latest earlier time on the path at that distance, found by stepping back 16 samples per row
+    /// interval and bisecting. Before the first row the path is continued backwards as a straight line
+    /// along its heading at t = 0 (as if the vehicle had driven straight into the first row). After the
+    /// last row the point of the last row's time is used (the vehicle stands).
+    pub fn trailing_point(&self, t: f64, dist: f64) -> (f64, f64) {
+        let t = t.clamp(0.0, self.last_time());
+        let f = self.point(t);
+        let away = |tau: f64| {
+            let q = self.point(tau);
+            (q.0 - f.0).hypot(q.1 - f.1) >= dist
+        };
+        // Sample times from t back to 0: the rows' times below t, each interval cut in 16.
+        let (k, _, _) = self.segment(t);
+        let mut near = t;
+        let mut found = None;
+        'back: for j in (0..=k).rev() {
+            let (t0, t1) = (self.times[j], self.times[j + 1].min(t));
+            for i in (0..16).rev() {
+                let tau = t0 + (t1 - t0) * i as f64 / 16.0;
+                if tau >= near {
+                    continue;
+                }
+                if away(tau) {
+                    found = Some((tau, near));
+                    break 'back;
+                }
+                near = tau;
+            }
+        }
+        if let Some((mut lo, mut hi)) = found {
+            // `lo` is at least `dist` away, `hi` closer: bisect to the last representable time.
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mid == lo || mid == hi {
+                    break;
+                }
+                if away(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return self.point(lo);
+        }
+        // On the straight continuation before the start: P₀ − s u with |P₀ − s u − F| = dist, s ≥ 0.
+        let p0 = self.point(0.0);
+        let (uy, ux) = self.heading(0.0).sin_cos();
+        let (wx, wy) = (p0.0 - f.0, p0.1 - f.1);
+        let wu = wx * ux + wy * uy;
+        let s = wu + (wu * wu - (wx * wx + wy * wy) + dist * dist).max(0.0).sqrt();
+        (p0.0 - s * ux, p0.1 - s * uy)
+    }
+
+    /// Heading \[rad\] of a vehicle whose front axle is on the path at `t` and whose rear axle, `dist` \[m\]
+    /// behind, is on the path too ([`Self::trailing_point`]): the direction from the rear to the front
+    /// point. On a circle of radius ρ it lags the tangent by asin(dist / 2ρ); on a straight path it is the
+    /// path's direction.
+    pub fn trailing_heading(&self, t: f64, dist: f64) -> f64 {
+        let f = self.point(t.clamp(0.0, self.last_time()));
+        let r = self.trailing_point(t, dist);
+        (f.1 - r.1).atan2(f.0 - r.0)
     }
 
     /// Horizontal velocity `(vx, vy)` at `t` \[m/s\]; zero after the last row.

@@ -6,26 +6,38 @@ use std::path::Path;
 /// Where the front axle's centre-line point is over time \[m, s\], its heading and its speed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Travel {
-    /// Along +x from `x0` on the channel's centre line (y = 0, heading 0) at a speed over time.
-    Along { x0: f64, speed: SpeedProfile },
-    /// A free path `t x y [z]`.
-    Path(VehiclePath),
+    /// Along +x from `x0` on the channel's centre line `y0` (heading 0) at a speed over time.
+    Along { x0: f64, y0: f64, speed: SpeedProfile },
+    /// A free path `t x y [z]` of the front axle; the rear axle, `wheelbase` \[m\] behind, trails it on
+    /// the path ([`VehiclePath::trailing_heading`]).
+    Path { path: VehiclePath, wheelbase: f64 },
 }
 
 impl Travel {
     /// Front axle's centre-line point `(x, y)` at `t` \[m\].
     pub fn front(&self, t: f64) -> (f64, f64) {
         match self {
-            Travel::Along { x0, speed } => (x0 + speed.distance(t), 0.0),
-            Travel::Path(p) => p.point(t),
+            Travel::Along { x0, y0, speed } => (x0 + speed.distance(t), *y0),
+            Travel::Path { path, .. } => path.point(t),
         }
     }
 
-    /// Heading at `t` \[rad from +x towards +y\].
+    /// The body's heading at `t` \[rad from +x towards +y\] with the rear axle `behind` \[m\] (horizontal)
+    /// behind the front one: along +x, or on a path the direction from the rear axle, trailing on the path
+    /// ([`VehiclePath::trailing_heading`]), to the front axle.
+    pub fn heading_with(&self, t: f64, behind: f64) -> f64 {
+        match self {
+            Travel::Along { .. } => 0.0,
+            Travel::Path { path, .. } => path.trailing_heading(t, behind),
+        }
+    }
+
+    /// [`Self::heading_with`] the whole wheelbase behind (the heading on level road; on a slope the
+    /// placement shortens the horizontal distance, see [`super::vehicle::place_along`]).
     pub fn heading(&self, t: f64) -> f64 {
         match self {
             Travel::Along { .. } => 0.0,
-            Travel::Path(p) => p.heading(t),
+            Travel::Path { wheelbase, .. } => self.heading_with(t, *wheelbase),
         }
     }
 
@@ -33,7 +45,7 @@ impl Travel {
     pub fn speed(&self, t: f64) -> f64 {
         match self {
             Travel::Along { speed, .. } => speed.speed(t),
-            Travel::Path(p) => p.speed(t),
+            Travel::Path { path, .. } => path.speed(t),
         }
     }
 
@@ -41,15 +53,15 @@ impl Travel {
     pub fn max_speed(&self) -> f64 {
         match self {
             Travel::Along { speed, .. } => speed.max_speed(),
-            Travel::Path(p) => p.max_speed(),
+            Travel::Path { path, .. } => path.max_speed(),
         }
     }
 
     /// First time the front axle reaches `x` \[m\] or beyond, `None` if never.
     pub fn time_to_x(&self, x: f64) -> Option<f64> {
         match self {
-            Travel::Along { x0, speed } => speed.time_to(x - x0),
-            Travel::Path(p) => p.time_to_x(x),
+            Travel::Along { x0, speed, .. } => speed.time_to(x - x0),
+            Travel::Path { path, .. } => path.time_to_x(x),
         }
     }
 }

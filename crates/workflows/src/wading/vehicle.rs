@@ -1,7 +1,7 @@
 //! The vehicle: its part files, its wheels (found by part name, with axle and radius), checks that name
 //! the scenario key of every problem, and its placement on the channel's road.
 
-use super::channel::{pitch, ChannelSpec, Road};
+use super::channel::{pitch, Road};
 use super::parts::{bounds, wheel_reach, NamedPart};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Invalid;
@@ -96,16 +96,16 @@ pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
     errs
 }
 
-/// A vehicle as wide as the channel or wider, named under `channel.width_m`.
-pub fn check_width(parts: &[NamedPart], channel: &ChannelSpec) -> Option<Invalid> {
+/// A vehicle as wide as the channel or wider: `width` \[m\] across the channel, reported under `key`
+/// with `what` describing where the width comes from (`"width_m = 4 m"`).
+pub fn check_width(parts: &[NamedPart], width: f64, key: &str, what: &str) -> Option<Invalid> {
     let b = bounds(parts);
     let across = b.max.y - b.min.y;
-    (across >= channel.width_m).then(|| Invalid {
-        key: "channel.width_m".into(),
+    (across >= width).then(|| Invalid {
+        key: key.into(),
         message: format!(
-            "width_m = {} m is not wider than the vehicle ({across:.3} m across its parts): it would not fit between \
-             the walls",
-            channel.width_m
+            "{what} is not wider than the vehicle ({across:.3} m across its parts): it would not fit between the \
+             walls"
         ),
     })
 }
@@ -136,6 +136,25 @@ impl Placement {
     }
 }
 
+/// The front wheel: the largest axle x.
+pub fn front_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
+    wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x))
+}
+
+/// The rear wheel: the smallest axle x.
+pub fn rear_wheel(wheels: &[WheelSpec]) -> Option<&WheelSpec> {
+    wheels.iter().min_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x))
+}
+
+/// Wheelbase \[m\]: the distance between the front and the rear axle in the x–z plane of the files (0
+/// without wheels).
+pub fn wheelbase(wheels: &[WheelSpec]) -> f64 {
+    match (front_wheel(wheels), rear_wheel(wheels)) {
+        (Some(f), Some(r)) => ((f.axle_m.x - r.axle_m.x).powi(2) + (f.axle_m.z - r.axle_m.z).powi(2)).sqrt(),
+        _ => 0.0,
+    }
+}
+
 /// Places the vehicle so that its front axle (the wheels' largest axle x), at the middle of the parts'
 /// extent across, is over `front = (x, y)` with the vehicle heading along `heading` \[rad from +x towards
 /// +y\], every wheel on the road: the front and rear axle heights from [`Road::axle_height`], the rear
@@ -149,17 +168,15 @@ pub fn place_on_road(
     front_at: (f64, f64),
     heading: f64,
 ) -> Placement {
-    let front = wheels.iter().max_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
-    let rear = wheels.iter().min_by(|a, b| a.axle_m.x.total_cmp(&b.axle_m.x));
-    let (Some(front), Some(rear)) = (front, rear) else {
+    let (Some(front), Some(rear)) = (front_wheel(wheels), rear_wheel(wheels)) else {
         return Placement { pitch: 0.0, yaw: 0.0, pivot: Vec3::ZERO, shift: Vec3::ZERO };
     };
     let b = bounds(parts);
     let y_mid = 0.5 * (b.min.y + b.max.y);
     let (x_front, y_front) = front_at;
-    // Axle-to-axle distance in the x–z plane; the rear axle sits on the road at that distance behind the
-    // front one along the heading (bisection on its x: the distance grows as the rear axle moves back).
-    let span = ((front.axle_m.x - rear.axle_m.x).powi(2) + (front.axle_m.z - rear.axle_m.z).powi(2)).sqrt();
+    // The rear axle sits on the road at the wheelbase behind the front one along the heading (bisection
+    // on its x: the distance grows as the rear axle moves back).
+    let span = wheelbase(wheels);
     let zf = road.axle_height(x_front, y_front, front.radius_m, heading);
     let (cos_h, tan_h) = (heading.cos(), heading.tan());
     let rear_y = |xr: f64| y_front + (xr - x_front) * tan_h;
@@ -173,6 +190,10 @@ pub fn place_on_road(
     let (mut lo, mut hi) = (x_front - span - 1.0, x_front);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
+        // Converged: lo and hi are neighbouring numbers, further steps change nothing.
+        if mid == lo || mid == hi {
+            break;
+        }
         if dist(mid) > span {
             lo = mid;
         } else {
@@ -197,6 +218,32 @@ pub fn place_on_road(
             zr - rear.axle_m.z,
         ),
     }
+}
+
+/// The vehicle placed on the road at time `t` of its travel ([`place_on_road`]). On a path the rear
+/// axle trails the front one on the path: the heading is the direction from the path's point the rear
+/// axle's horizontal distance behind to the front axle, and since that distance is the wheelbase shortened
+/// by the pitch (on a ramp), it is found by fixed-point iteration (three rounds from the whole wheelbase:
+/// the distance changes by (1 − cos θ) of the wheelbase, the heading by far less).
+pub fn place_along(
+    parts: &[NamedPart],
+    wheels: &[WheelSpec],
+    road: &dyn Road,
+    travel: &super::timeline::Travel,
+    t: f64,
+) -> Placement {
+    let front = travel.front(t);
+    let mut p = place_on_road(parts, wheels, road, front, travel.heading(t));
+    if let (super::timeline::Travel::Path { .. }, Some(rear)) = (travel, rear_wheel(wheels)) {
+        let b = bounds(parts);
+        let rear_mid = Vec3::new(rear.axle_m.x, 0.5 * (b.min.y + b.max.y), rear.axle_m.z);
+        for _ in 0..3 {
+            let r = p.apply(rear_mid);
+            let behind = (front.0 - r.x).hypot(front.1 - r.y);
+            p = place_on_road(parts, wheels, road, front, travel.heading_with(t, behind));
+        }
+    }
+    p
 }
 
 /// Angular speed \[rad/s\] about +axis of a wheel of radius `r` rolling without slip at speed `v` along
@@ -239,8 +286,8 @@ pub(crate) mod tests {
     }
 
     /// The shared test channel, lengthened to take the 4 m wheelbase.
-    fn channel() -> ChannelSpec {
-        ChannelSpec {
+    fn channel() -> crate::wading::channel::ChannelSpec {
+        crate::wading::channel::ChannelSpec {
             approach_length_m: 8.0,
             pool_length_m: 10.0,
             ..crate::wading::channel::tests::channel()
@@ -268,10 +315,8 @@ pub(crate) mod tests {
     #[test]
     fn a_vehicle_wider_than_the_channel_is_named() {
         let (parts, _) = truck();
-        let mut c = channel();
-        assert!(check_width(&parts, &c).is_none());
-        c.width_m = 2.2;
-        let e = check_width(&parts, &c).unwrap();
+        assert!(check_width(&parts, channel().width_m, "channel.width_m", "width_m = 4 m").is_none());
+        let e = check_width(&parts, 2.2, "channel.width_m", "width_m = 2.2 m").unwrap();
         assert_eq!(e.key, "channel.width_m");
         assert!(e.message.contains("2.300 m across"), "{}", e.message);
     }
