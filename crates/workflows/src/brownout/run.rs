@@ -266,7 +266,7 @@ struct Unsteady {
     /// Start \[s\] and length \[s\] of the window (0: a steady field).
     start: f64,
     span: f64,
-    /// Times at which the source's flux is averaged (1: a steady field).
+    /// Times at which the source's flux is averaged (1 for a steady field; an unsteady one may use 1 too).
     phases: usize,
 }
 

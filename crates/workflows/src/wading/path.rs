@@ -208,8 +208,12 @@ impl VehiclePath {
     /// Heading \[rad\] of a vehicle whose front axle is on the path at `t` and whose rear axle, `dist` \[m\]
     /// behind, is on the path too ([`Self::trailing_point`]): the direction from the rear to the front
     /// point. On a circle of radius ρ it lags the tangent by asin(dist / 2ρ); on a straight path it is the
-    /// path's direction.
+    /// path's direction. With no wheelbase (`dist` ≤ 0: a single axle) the rear point is the front point: the path's
+    /// tangent heading is used.
     pub fn trailing_heading(&self, t: f64, dist: f64) -> f64 {
+        if dist <= 0.0 {
+            return self.heading(t);
+        }
         let f = self.point(t.clamp(0.0, self.last_time()));
         let r = self.trailing_point(t, dist);
         (f.1 - r.1).atan2(f.0 - r.0)
@@ -375,6 +379,21 @@ mod tests {
         assert!((p.heading(3.0) - 0.5f64.atan()).abs() < 1e-12, "the last heading is kept at rest");
         assert!((p.time_to_x(3.0).unwrap() - 1.0).abs() < 1e-12);
         assert!(p.time_to_x(5.5).is_none());
+    }
+
+    /// A single axle (no wheelbase) has no rear point to trail: its heading is the path's tangent, exactly.
+    #[test]
+    fn a_single_axle_heads_along_the_tangent() {
+        let rows: Vec<Vec<f64>> = (0..=8)
+            .map(|k| {
+                let a = 0.1 * k as f64;
+                vec![k as f64, 20.0 * a.sin(), 20.0 * (1.0 - a.cos())]
+            })
+            .collect();
+        let p = VehiclePath::from_rows(&rows).unwrap();
+        for t in [0.0, 1.3, 4.0, 7.9] {
+            assert_eq!(p.trailing_heading(t, 0.0), p.heading(t), "t = {t}");
+        }
     }
 
     /// Rows on a circle of radius 20 m driven at 2 m/s (turning at ω = 0.1 rad/s, 1 rad in all), 0.5 s

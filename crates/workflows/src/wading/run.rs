@@ -204,9 +204,6 @@ fn read_path(p: &super::config::PathSpec) -> Result<VehiclePath, WadingError> {
 /// Relative tolerance of a path row's height against the height the road carries the front axle at.
 pub const PATH_Z_TOLERANCE: f64 = 0.05;
 
-/// A path's heights agree with the road (within [`PATH_Z_TOLERANCE`] of the front wheel's radius), and
-/// the vehicle stays inside the channel all the way: the corners of its parts' bounding box, placed on
-/// the road, between the side walls and over the channel's length, sampled every 2 cm of travel.
 /// On a channel from a file, road under both axles all the way (sampled every 2 cm of travel): the
 /// message names the time, the axle and the road's extent.
 fn check_road_under_axles(
@@ -249,6 +246,9 @@ fn check_road_under_axles(
     Ok(())
 }
 
+/// A path's heights agree with the road (within [`PATH_Z_TOLERANCE`] of the front wheel's radius), and
+/// the vehicle stays inside the channel all the way: the corners of its parts' bounding box, placed on
+/// the road, between the side walls and over the channel's length, sampled every 2 cm of travel.
 fn check_path(
     cfg: &WadingConfig,
     channel: &Channel,
@@ -422,6 +422,11 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
         write_stl(&file, &name, &mesh).map_err(io_err(&file))?;
         walls.push(wall(&name, file, None, cfg.channel.adhesion, layers));
     }
+    // The middle of the axles across the vehicle (its own frame), for the wheels' view side.
+    let (lo_y, hi_y) = wheels
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| (a.min(w.axle_m.y), b.max(w.axle_m.y)));
+    let axles_mid_y = 0.5 * (lo_y + hi_y);
     for part in &plan.parts {
         let mut mesh = part.mesh.clone();
         mesh.vertices.iter_mut().for_each(|v| *v = p0.apply(*v));
@@ -448,9 +453,11 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
             None => "body".into(),
         };
         let mut w = wall(&part.name, file, Some(motion), cfg.vehicle.adhesion, None);
-        // A wheel's map is seen from outside the vehicle, looking at its outer face.
+        // A wheel's map is seen from outside the vehicle, looking at its outer face: the side is the
+        // wheel's side of the vehicle (its own frame, against the middle of the axles), so a vehicle off
+        // the channel's centre line still shows both wheels from outside.
         if let Some(spec) = wheels.iter().find(|w| w.part == part.name) {
-            let side = if p0.apply(spec.axle_m).y >= ch.centre_y() { -1.0 } else { 1.0 };
+            let side = if spec.axle_m.y >= axles_mid_y { -1.0 } else { 1.0 };
             w.view_dir = Some(Vec3::new(0.0, side, 0.0));
             w.up = Some(Vec3::Z);
         }
