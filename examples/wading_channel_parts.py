@@ -8,9 +8,9 @@ the road at z = 0 outside the pool.
 The entry ramp (2.5 m) is longer than the exit ramp (1.5 m), unlike a generated channel. The road faces
 up, the walls face into the channel. Run: python3 wading_channel_parts.py
 """
-import os
+# The STL writer of the truck's parts (same folder).
+from wading_truck_parts import write
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 HALF_WIDTH = 2.0   # walls at y = -2 and +2 [m]
 WALL_TOP = 1.0     # wall top above the road [m]
 # Road profile along the centre line: (x, z) break points [m].
@@ -34,24 +34,6 @@ def wall(y):
         # Normal towards the channel's middle: -y for the wall at +y, +y for the wall at -y.
         tris += [(a, b, c), (a, c, d)] if y > 0 else [(a, c, b), (a, d, c)]
     return tris
-
-
-def write(name, solids):
-    path = os.path.join(HERE, name)
-    with open(path, "w") as f:
-        for solid, tris in solids:
-            f.write(f"solid {solid}\n")
-            for a, b, c in tris:
-                u = [b[i] - a[i] for i in range(3)]
-                w = [c[i] - a[i] for i in range(3)]
-                n = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
-                ln = sum(x * x for x in n) ** 0.5 or 1.0
-                f.write("facet normal {:.6g} {:.6g} {:.6g}\n outer loop\n".format(*(x / ln for x in n)))
-                for p in (a, b, c):
-                    f.write("  vertex {:.6f} {:.6f} {:.6f}\n".format(*p))
-                f.write(" endloop\nendfacet\n")
-            f.write(f"endsolid {solid}\n")
-    print("wrote", path)
 
 
 write("wading_channel.stl", [("road", road()), ("wall_left", wall(HALF_WIDTH)), ("wall_right", wall(-HALF_WIDTH))])

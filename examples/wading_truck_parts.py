@@ -57,20 +57,21 @@ def write(name, solids):
     print("wrote", path)
 
 
-half = 0.5 * TRACK
-write("wading_truck_body.stl", [
-    ("cab", box((3.3, -1.25, 1.1), (5.3, 1.25, 3.2))),
-    ("chassis", box((-1.2, -0.55, 0.6), (5.3, 0.55, 1.05))),
-])
-write("wading_truck_wheels.stl", [
-    ("wheel_fl", wheel(FRONT_X, half, R)),
-    ("wheel_fr", wheel(FRONT_X, -half, R)),
-    ("wheel_rl", wheel(REAR_X, half, R)),
-    ("wheel_rr", wheel(REAR_X, -half, R)),
-])
-write("wading_truck_sensors.stl", [
-    ("mirror_left", box((4.9, 1.3, 2.2), (5.05, 1.45, 2.5))),
-    ("mirror_right", box((4.9, -1.45, 2.2), (5.05, -1.3, 2.5))),
-    ("camera_front", box((5.3, -0.1, 0.6), (5.4, 0.1, 0.72))),
-    ("camera_side", box((4.3, 1.25, 1.15), (4.45, 1.32, 1.27))),
-])
+if __name__ == "__main__":
+    half = 0.5 * TRACK
+    write("wading_truck_body.stl", [
+        ("cab", box((3.3, -1.25, 1.1), (5.3, 1.25, 3.2))),
+        ("chassis", box((-1.2, -0.55, 0.6), (5.3, 0.55, 1.05))),
+    ])
+    write("wading_truck_wheels.stl", [
+        ("wheel_fl", wheel(FRONT_X, half, R)),
+        ("wheel_fr", wheel(FRONT_X, -half, R)),
+        ("wheel_rl", wheel(REAR_X, half, R)),
+        ("wheel_rr", wheel(REAR_X, -half, R)),
+    ])
+    write("wading_truck_sensors.stl", [
+        ("mirror_left", box((4.9, 1.3, 2.2), (5.05, 1.45, 2.5))),
+        ("mirror_right", box((4.9, -1.45, 2.2), (5.05, -1.3, 2.5))),
+        ("camera_front", box((5.3, -0.1, 0.6), (5.4, 0.1, 0.72))),
+        ("camera_side", box((4.3, 1.25, 1.15), (4.45, 1.32, 1.27))),
+    ])

@@ -22,15 +22,7 @@ root="$(cd "$here/../.." && pwd)"
 cd "$root"
 steps="${STEPS:-1000}"
 repeat="${REPEAT:-2}"
-target="${CARGO_TARGET_DIR:-target}"
-if [ -n "${SPATTER:-}" ]; then
-    exe="$SPATTER"
-else
-    cargo build --release -p spatter-cli --features mpi --locked
-    exe="$target/release/spatter"
-fi
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
+. "$root/bench/mpi_spatter.sh"
 dt="$(awk -F' = ' '/^dt_s/ {print $2}' examples/dem_pile.toml)"
 duration="$(awk -v n="$steps" -v dt="$dt" 'BEGIN {printf "%.10g", n * dt}')"
 # The example in a box of lx × 0.24 m with the lattice 0.12 m high, one output at

@@ -16,15 +16,7 @@ root="$(cd "$here/../.." && pwd)"
 cd "$root"
 end="${END:-0.02}"
 repeat="${REPEAT:-2}"
-target="${CARGO_TARGET_DIR:-target}"
-if [ -n "${SPATTER:-}" ]; then
-    exe="$SPATTER"
-else
-    cargo build --release -p spatter-cli --features mpi --locked
-    exe="$target/release/spatter"
-fi
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
+. "$root/bench/mpi_spatter.sh"
 # The example with a shorter end time and no particle output beyond the first.
 sed -e "s/^end_time_s = .*/end_time_s = $end/" -e "s/^vtu_interval_s = .*/vtu_interval_s = 10.0/" \
     examples/sph_dam_break.toml > "$work/dam.toml"
