@@ -10,6 +10,10 @@ use crate::dem_scene::events::ObjectRecord;
 use crate::dem_scene::SceneResults;
 use spatter_core::Vec3;
 use spatter_io::fmt_f64;
+use spatter_io::plot::{bar_chart_png, field_map_png_with_lines, Bars, Chart, FieldMap};
+use spatter_io::run::{CurveRecord, MeshMapRecord, RunContext, RunSummary, ScalarTableRecord};
+use spatter_io::vtu::Vtu;
+use std::path::Path;
 
 /// A table cell for a derived statistic: NaN here only ever means "undefined" (the share of a panel with
 /// no damage, the spread of fewer than two impacts, the entrance angle of a stone that never left the
@@ -21,10 +25,11 @@ fn gap(x: f64) -> String {
         fmt_f64(x)
     }
 }
-use spatter_io::plot::{bar_chart_png, field_map_png_with_lines, Bars, Chart, FieldMap};
-use spatter_io::run::{MeshMapRecord, RunContext, RunSummary};
-use spatter_io::vtu::Vtu;
-use std::path::Path;
+
+/// Label of the strip-share curve a run records (a study overlays it across cases).
+pub const STRIP_SHARE_CURVE: &str = "share of the eroded mass per strip";
+/// Label of the strip-share table a run records (a study shows it with a column per case).
+pub const STRIP_SHARE_TABLE: &str = "share of the eroded mass per strip in percent";
 
 /// Mean, sample standard deviation (n − 1), minimum and maximum of a set of values; NaN where undefined
 /// (no values; the deviation of a single value).
@@ -261,6 +266,16 @@ pub fn report(
         &rows,
     )
     .map_err(io_err(&path))?;
+    // For a study: the shares of every case in one chart (strip number against share) and one table
+    // with a column per case (docs/studies.md, "Curves and tables across cases").
+    summary.curves.push(CurveRecord {
+        label: STRIP_SHARE_CURVE.into(),
+        csv: path.clone(),
+        x_column: "strip".into(),
+        y_column: "share_percent".into(),
+        x_label: "strip (1 = top)".into(),
+        y_label: "share of the eroded mass [%]".into(),
+    });
     summary.artifacts.push(("damage share per strip".into(), path));
     let png = dir.path("strips.png");
     let names: Vec<String> = (1..=n_strips).map(|k| format!("strip {k}")).collect();
@@ -273,10 +288,16 @@ pub fn report(
     )
     .map_err(io_err(&png))?;
     summary.artifacts.push(("damage share per strip (chart)".into(), png));
+    let mut rows = Vec::new();
     for (k, s) in share.iter().enumerate() {
         if s.is_finite() {
-            summary.scalar(&format!("strip_{}_share_percent", k + 1), *s);
+            let name = format!("strip_{}_share_percent", k + 1);
+            summary.scalar(&name, *s);
+            rows.push((format!("strip {}", k + 1), name));
         }
+    }
+    if !rows.is_empty() {
+        summary.scalar_tables.push(ScalarTableRecord { label: STRIP_SHARE_TABLE.into(), rows });
     }
     summary.scalar("panel_eroded_mass_kg", total);
     // Damage centroid: height along the panel from its bottom edge, and height above the pipe axis.

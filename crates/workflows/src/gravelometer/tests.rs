@@ -4,7 +4,7 @@
 
 use super::config::{preset, GravelometerConfig, GravelometerInput, Standard};
 use super::scene::{empirical_launch_speed, feeder_vertical_speed, plan};
-use super::{run, GravelometerError};
+use super::{results, run, GravelometerError};
 use spatter_core::check::Checker;
 use spatter_core::control::Unattended;
 use spatter_io::run::{RunContext, RunDir, RunSummary};
@@ -279,6 +279,19 @@ fn every_injected_stone_is_accounted_for() {
     assert_eq!(strips.len(), 5);
     let total: f64 = strips.iter().map(|r| r[4].parse::<f64>().unwrap()).sum();
     assert!((total - 100.0).abs() < 1e-9, "{total}");
+    // ... and are recorded for a study: the curve strip → share from strips.csv (overlaid across cases)
+    // and the table of the five share scalars (one column per case).
+    let curve =
+        s.curves.iter().find(|c| c.label == results::STRIP_SHARE_CURVE).expect("strip curve recorded");
+    assert!(
+        curve.csv.ends_with("strips.csv") && curve.x_column == "strip" && curve.y_column == "share_percent"
+    );
+    let table = s.scalar_tables.iter().find(|t| t.label == results::STRIP_SHARE_TABLE).expect("strip table");
+    let named: Vec<&str> = table.rows.iter().map(|(_, n)| n.as_str()).collect();
+    assert_eq!(named, (1..=5).map(|k| format!("strip_{k}_share_percent")).collect::<Vec<_>>());
+    for (_, n) in &table.rows {
+        assert!(s.scalars.iter().any(|(k, _)| k == n), "{n} reported");
+    }
     for f in [
         "panel_damage.png",
         "panel_damage.vtu",
