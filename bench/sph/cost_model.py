@@ -18,10 +18,12 @@ with about 10^8 fluid particles on 16, 64 and 256 nodes, from:
 * an interconnect described by its latency and bandwidth (defaults: an InfiniBand HDR node link,
   200 Gbit/s, shared by the node's ranks; see the option help).
 
-Three ways to run are compared: the current engine with one rank per core (every rank holds and
-processes every wall particle), the current engine with one rank per node and a thread per core (its
-walls' per-step rebuild runs on one thread), and one rank per core with the walls split over the ranks
-like the fluid (not built yet; walls assumed spread evenly). Only the standard
+Four ways to run are compared: every wall particle in every rank's wall set (the engine before
+2026-11-26), only the wall particles within one support of the rank's box in its wall set (the engine
+now) with one rank per core and with one rank per node and a thread per core (the wall set's per-step
+rebuild runs on one thread), and the boundary also stored only where it is needed (not built: today
+every rank holds the reference positions of every wall particle). Walls are assumed spread over the
+ranks like the water. Only the standard
 library is used. Every assumption is an option; `--help` lists them.
 """
 
@@ -179,7 +181,13 @@ def main():
                     help="seconds of one core per halo particle and step (binning, state from density)")
     ap.add_argument("--thread-efficiency", type=float, default=0.8,
                     help="parallel efficiency of a node's threads for one rank per node")
-    ap.add_argument("--wall-bytes", type=float, default=200.0, help="bytes held per wall particle")
+    ap.add_argument("--wall-bytes", type=float, default=75.0,
+                    help="bytes of the boundary's own arrays per wall particle (reference position and "
+                         "normal, volume, area, part, wet flag and time), held by every rank")
+    ap.add_argument("--wall-set-bytes", type=float, default=120.0,
+                    help="bytes per entry of a rank's wall set (position, velocity, state, grid)")
+    ap.add_argument("--chunk-test-s", type=float, default=2e-8,
+                    help="seconds to place and test one chunk of 256 wall particles against the rank's box")
     ap.add_argument("--fluid-bytes", type=float, default=412.0,
                     help="bytes held per fluid or halo particle (`spatter bench sph`)")
     args = ap.parse_args()
@@ -219,27 +227,37 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     cores = args.cores_per_node
     lat = args.latency_us * 1e-6
+    layouts = [
+        # (name, one rank per node, only the walls near the box in the wall set, boundary stored split)
+        ("every wall in every rank's wall set (before 2026-11-26), rank per core", False, False, False),
+        ("walls near the box, rank per core", False, True, False),
+        ("walls near the box, rank per node", True, True, False),
+        ("walls near the box and stored only there (not built), rank per core", False, True, True),
+    ]
     for nodes in (int(n) for n in args.nodes.split(",")):
-        for layout in ("rank per core, walls on every rank", "rank per node, walls on every rank",
-                       "rank per core, walls split (not built)"):
-            per_node = layout.startswith("rank per node")
+        for name, per_node, local, stored in layouts:
             ranks = nodes if per_node else nodes * cores
             speedup = cores * args.thread_efficiency if per_node else 1.0
             n_rank = args.particles / ranks
             halo, peers_mean, peers_max = decomposition(ranks, water, halo_w, dp)
-            w_rank = walls / ranks if "split" in layout else walls
+            # The walls within one support of a box: its share, plus the band one support wide around
+            # it (counted like the fluid's halo at that width: an upper bound for surfaces).
+            band = decomposition(ranks, water, support, dp)[0] / n_rank
+            w_set = walls / ranks * (1.0 + band) if local else walls
             compute = (cf * n_rank + args.halo_cost * halo) / speedup
-            # The per-step rebuild of the wall set (`build_wall_set`) is a serial loop today, so the
-            # walls held by a rank of many threads are charged to one thread.
-            wall_t = cw * w_rank
+            # The per-step rebuild of the wall set (`build_wall_set`) is a serial loop, so the walls of
+            # a rank of many threads are charged to one thread; the chunk tests run on all of them.
+            wall_t = cw * w_set + (args.chunk_test_s * walls / 256 / speedup if local else 0.0)
             ranks_per_node = 1 if per_node else cores
             bw = args.link_gb_s * 1e9 / ranks_per_node
             reduce_t = 3 * lat * math.ceil(math.log2(ranks)) if ranks > 1 else 0.0
             comm = 2 * lat * peers_max + 56 * halo / bw + reduce_t
             step = compute + wall_t + comm
             hours = steps * step / 3600
-            mem = ranks_per_node * ((n_rank + halo) * args.fluid_bytes + w_rank * args.wall_bytes) / 1e9
-            print(f"| {layout} | {nodes} | {ranks} | {n_rank:.3g} | {halo / n_rank:.2f} | "
+            held = w_set if stored else walls
+            mem = ranks_per_node * ((n_rank + halo) * args.fluid_bytes + held * args.wall_bytes
+                                    + w_set * args.wall_set_bytes) / 1e9
+            print(f"| {name} | {nodes} | {ranks} | {n_rank:.3g} | {halo / n_rank:.2f} | "
                   f"{peers_mean:.1f}, {peers_max} | {compute * 1e3:.1f} | {wall_t * 1e3:.1f} | "
                   f"{comm * 1e3:.2f} | {step * 1e3:.1f} | {hours:.3g} | {hours * nodes * cores:.3g} | "
                   f"{mem:.3g} |")

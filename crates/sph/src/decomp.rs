@@ -15,7 +15,8 @@
 //! 3. **reductions** — the time step comes from maxima over all ranks (exact, identical everywhere), the
 //!    counts (interactions, guard stops, removals) from integer sums.
 //!
-//! Walls are replicated: every rank holds the whole boundary and moves it by the same kinematics. The
+//! Walls are replicated: every rank holds the whole boundary and moves it by the same kinematics, but its
+//! wall set holds only the wall particles within one support of its box (`local_walls`). The
 //! state of a wall entry (Adami extrapolation) needs the fluid within one support of it; with a halo two
 //! supports wide every wall entry within one support of the box, the only ones the owned fluid sees, gets
 //! a complete neighbourhood, so no wall state travels. (Sending one support of fluid plus the wall state
@@ -34,6 +35,7 @@
 
 use super::{PartLoad, PassStats, Simulation};
 use crate::error::SphError;
+use crate::local_walls::point_gap;
 use rayon::prelude::*;
 use spatter_core::comm::{Comm, WireReader, WireWriter};
 use spatter_core::rcb::{Peer, Rcb};
@@ -70,6 +72,11 @@ impl Decomp {
     pub(super) fn owns(&self, x: Vec3) -> bool {
         self.rcb.owner(x) == self.rank
     }
+
+    /// This rank's box (the region whose walls it needs, within one support of it).
+    pub(super) fn rank_region(&self) -> Aabb {
+        self.boxes[self.rank]
+    }
 }
 
 /// What one rank saw in its part of a step, before the reductions.
@@ -83,18 +90,6 @@ pub(crate) struct LocalCounts {
 }
 
 const WHAT: [&str; 3] = ["position", "velocity", "density"];
-
-/// Euclidean distance from `x` to the box `b` (0 inside; infinite faces never add) \[m\].
-fn point_gap(x: Vec3, b: &Aabb) -> f64 {
-    let mut d2 = 0.0;
-    for a in 0..3 {
-        let g = (b.min[a] - x[a]).max(x[a] - b.max[a]).max(0.0);
-        if g.is_finite() {
-            d2 += g * g;
-        }
-    }
-    d2.sqrt()
-}
 
 impl Simulation {
     /// Advances one time step on the ranks of `comm` (collective: every rank calls it once per step).
@@ -189,6 +184,7 @@ impl Simulation {
             last_migrants: 0,
         });
         self.work.ready = false;
+        self.work.walls_built = false;
     }
 
     /// The split of space over the ranks (`None` on one rank): a checkpoint of a run on ranks saves it
@@ -289,7 +285,13 @@ impl Simulation {
 
     /// This rank's box, when the fluid is split.
     pub fn rank_box(&self) -> Option<Aabb> {
-        self.decomp.as_ref().map(|d| d.boxes[d.rank])
+        self.decomp.as_ref().map(|d| d.rank_region())
+    }
+
+    /// Wall entries (wall particles and their periodic images) in this rank's wall set: on several ranks
+    /// only those within one kernel support of its box (module `local_walls`).
+    pub fn wall_entries(&self) -> usize {
+        self.work.w_src.len()
     }
 
     /// Halo particles received and particles migrated in the last step on this rank.

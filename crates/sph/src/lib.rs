@@ -27,6 +27,7 @@ pub mod fill;
 pub mod fluid;
 pub mod guard;
 pub mod kernel;
+mod local_walls;
 pub mod neighbours;
 pub mod params;
 mod pass;

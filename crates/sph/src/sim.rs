@@ -26,6 +26,7 @@ use crate::fill::{fill_box, flood_fill, Clearance};
 use crate::fluid::{Fluid, PermuteScratch};
 use crate::guard::guard_particle;
 use crate::kernel::{Dim, Kernel};
+use crate::local_walls::{point_gap, LocalWalls};
 use crate::neighbours::NeighbourGrid;
 use crate::params::SphParams;
 use crate::pass::{self, Consts, FluidOut, FluidSet, PassStats, WallSet};
@@ -150,6 +151,10 @@ struct Work {
     w_tmp_b: Vec<bool>,
     /// Fluid particles with a wall entry within the cut-off (set by the wall pass).
     w_touched: pass::WallFlags,
+    /// On several ranks: the wall particles within one support of this rank's box.
+    w_local: LocalWalls,
+    /// Boundary size when the wall set was built.
+    w_built_len: usize,
     walls_built: bool,
     ready: bool,
     times: PhaseTimes,
@@ -638,19 +643,28 @@ impl Simulation {
         if w.walls_built
             && !periodic
             && !b.any_moving()
-            && w.w_src.len() == b.len()
+            && w.w_built_len == b.len()
             && w.w_c32.origin() == origin
         {
             return;
         }
+        w.w_built_len = b.len();
         w.w_src.clear();
         w.w_ghost.clear();
         w.w_pos.clear();
-        for i in 0..b.len() {
-            w.w_src.push(i as u32);
-            w.w_ghost.push(false);
-            w.w_pos.push(b.position(i));
+        // On several ranks only the walls within one support of the rank's box: the ones its fluid sees
+        // (module `local_walls`). Periodic runs select after adding the images, below.
+        let region = self.decomp.as_ref().map(|d| d.rank_region());
+        match region {
+            Some(region) if !periodic => w.w_local.select(b, &region, support, &mut w.w_src, &mut w.w_pos),
+            _ => {
+                for i in 0..b.len() {
+                    w.w_src.push(i as u32);
+                    w.w_pos.push(b.position(i));
+                }
+            }
         }
+        w.w_ghost.resize(w.w_src.len(), false);
         for a in 0..3 {
             if !self.periodic[a] {
                 continue;
@@ -669,6 +683,18 @@ impl Simulation {
                     }
                 }
             }
+        }
+        if let (Some(region), true) = (region, periodic) {
+            let mut k = 0;
+            for j in 0..w.w_src.len() {
+                if point_gap(w.w_pos[j], &region) <= support {
+                    (w.w_src[k], w.w_ghost[k], w.w_pos[k]) = (w.w_src[j], w.w_ghost[j], w.w_pos[j]);
+                    k += 1;
+                }
+            }
+            w.w_src.truncate(k);
+            w.w_ghost.truncate(k);
+            w.w_pos.truncate(k);
         }
         w.w_grid.rebuild(&w.w_pos, support);
         // Fluid particles far from every wall skip their wall query.

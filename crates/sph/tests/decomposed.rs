@@ -127,6 +127,44 @@ fn dam_break_run(n: usize, steps: usize, every: usize) -> (Vec<(f64, f64)>, Vec<
     .remove(0)
 }
 
+/// On several ranks a rank's wall set holds only the wall particles within one kernel support of its box
+/// (the ones its fluid sees), not the whole boundary: on 4 ranks of the dam break every rank holds fewer
+/// than the whole tank, exactly the wall particles within reach of its box (counted here from the
+/// boundary and the rank's box), and together at most the whole tank plus the entries near two boxes.
+/// That the runs still agree with one rank is `dam_break_2d_on_1_2_4_ranks` (a wall entry missing near
+/// a cut moves particles by orders of magnitude more than its tolerance).
+#[test]
+fn each_rank_holds_the_walls_near_its_box() {
+    let held = on_ranks(4, |comm| {
+        let mut sim = dam_break();
+        sim.initialize_with(comm).unwrap();
+        for _ in 0..20 {
+            sim.step_with(comm).unwrap();
+        }
+        let support = sim.kernel().support();
+        let region = sim.rank_box().unwrap();
+        let gap = |x: Vec3| {
+            let mut d2 = 0.0;
+            for a in 0..3 {
+                let g = (region.min[a] - x[a]).max(x[a] - region.max[a]).max(0.0);
+                if g.is_finite() {
+                    d2 += g * g;
+                }
+            }
+            d2.sqrt()
+        };
+        let near = (0..sim.boundary.len()).filter(|&i| gap(sim.boundary.position(i)) <= support).count();
+        (sim.wall_entries(), near, sim.boundary.len())
+    });
+    let total = held[0].2;
+    for (rank, &(entries, near, _)) in held.iter().enumerate() {
+        assert_eq!(entries, near, "rank {rank}: the walls within one support of its box");
+        assert!(entries > 0 && entries < total, "rank {rank}: {entries} of {total}");
+    }
+    let sum: usize = held.iter().map(|h| h.0).sum();
+    assert!(sum < 2 * total, "{sum} entries on 4 ranks for {total} wall particles");
+}
+
 /// The 2D dam break on 2 and 4 ranks against 1 rank, until the surge has run a column width
 /// (T = t √(2g/a) ≈ 1.6; the Martin & Moyce 1952 set-up). The cuts run through the column and the surge,
 /// so particles and halo cross them all the time. The particle set and count are exact in every step.

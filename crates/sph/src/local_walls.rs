@@ -1,0 +1,177 @@
+//! The wall particles a rank needs: on several ranks every rank holds the whole boundary (its reference
+//! positions and frames), but only the wall particles within one kernel support of its box enter its
+//! wall set — the ones its own fluid can see. Everything a step does per wall particle (placing it,
+//! binning it, its extrapolated state, its wet flag) then scales with the rank's share of the walls
+//! instead of with all of them (docs/scaling.md: with every wall on every rank a 10⁸-particle wading
+//! case spends seconds per step on walls whatever the number of ranks).
+//!
+//! To avoid even placing every wall particle each step, a part's particles are grouped in chunks of
+//! [`CHUNK`] consecutive indices with their bounding box in the part's reference frame; a chunk whose
+//! box, carried by the part's current frame, lies farther than the reach from the rank's box is skipped
+//! whole. Consecutive indices are usually near each other (lattice and surface sampling fill a part row
+//! by row), which keeps the chunk boxes tight; where they are not, the chunks are only looser, never
+//! wrong. The selected particles come out in increasing index order, the order of the full wall set.
+
+use crate::boundary::Boundary;
+use rayon::prelude::*;
+use spatter_core::{Aabb, Vec3};
+
+/// Wall particles per chunk.
+const CHUNK: usize = 256;
+
+/// Consecutive wall particles `start..end` of one part and their bounding box in its reference frame.
+#[derive(Clone, Debug)]
+struct Chunk {
+    start: u32,
+    end: u32,
+    part: u16,
+    /// Centre and half extent of the box of the reference positions \[m\].
+    centre: Vec3,
+    half: Vec3,
+}
+
+/// The chunks of a boundary and scratch for the selection; rebuilt when the boundary changes size.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LocalWalls {
+    chunks: Vec<Chunk>,
+    /// Per chunk: whether its box is within reach (scratch of [`Self::select`]).
+    near: Vec<bool>,
+    /// Boundary size the chunks were built for.
+    built_for: usize,
+}
+
+/// Euclidean distance from `x` to the box `b` (0 inside; infinite faces never add) \[m\].
+pub(crate) fn point_gap(x: Vec3, b: &Aabb) -> f64 {
+    box_gap(x, x, b)
+}
+
+/// Euclidean distance between the box `lo..hi` and the box `b` (0 when they overlap; infinite faces of
+/// `b` never add) \[m\].
+fn box_gap(lo: Vec3, hi: Vec3, b: &Aabb) -> f64 {
+    let mut d2 = 0.0;
+    for a in 0..3 {
+        let g = (b.min[a] - hi[a]).max(lo[a] - b.max[a]).max(0.0);
+        if g.is_finite() {
+            d2 += g * g;
+        }
+    }
+    d2.sqrt()
+}
+
+impl LocalWalls {
+    fn build(&mut self, b: &Boundary) {
+        self.chunks.clear();
+        for (k, part) in b.parts.iter().enumerate() {
+            let mut start = part.start;
+            while start < part.end {
+                let end = (start + CHUNK).min(part.end);
+                let bx = Aabb::from_points(&b.ref_pos[start..end]);
+                self.chunks.push(Chunk {
+                    start: start as u32,
+                    end: end as u32,
+                    part: k as u16,
+                    centre: 0.5 * (bx.min + bx.max),
+                    half: 0.5 * (bx.max - bx.min),
+                });
+                start = end;
+            }
+        }
+        self.near.resize(self.chunks.len(), false);
+        self.built_for = b.len();
+    }
+
+    /// Appends to `src` and `pos` the index and current world position of every wall particle of `b`
+    /// within `reach` \[m\] of `region`, in increasing index order.
+    pub(crate) fn select(
+        &mut self,
+        b: &Boundary,
+        region: &Aabb,
+        reach: f64,
+        src: &mut Vec<u32>,
+        pos: &mut Vec<Vec3>,
+    ) {
+        if self.built_for != b.len() || (self.chunks.is_empty() && !b.is_empty()) {
+            self.build(b);
+        }
+        self.near.par_iter_mut().zip(self.chunks.par_iter()).with_min_len(256).for_each(|(near, c)| {
+            let f = &b.frames[c.part as usize];
+            let centre = f.to_world(c.centre);
+            let half = f.rot.abs() * c.half;
+            *near = box_gap(centre - half, centre + half, region) <= reach;
+        });
+        for (c, _) in self.chunks.iter().zip(&self.near).filter(|(_, &near)| near) {
+            for i in c.start as usize..c.end as usize {
+                let x = b.position(i);
+                if point_gap(x, region) <= reach {
+                    src.push(i as u32);
+                    pos.push(x);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::Dim;
+    use crate::params::SphParams;
+    use crate::sim::{Simulation, WallOptions};
+
+    /// The selection equals the brute-force filter of every wall particle (same indices, same order,
+    /// same positions) for a tank and a rotated, moved box part, for regions inside, across and outside
+    /// the walls, and a region with infinite faces (an outer rank box of an unbounded domain).
+    #[test]
+    fn selection_equals_the_filter_of_every_wall_particle() {
+        let mut sim = Simulation::new(SphParams::water(Dim::Three, 0.02, 10.0));
+        let open_top = [true, true, true, true, true, false];
+        sim.add_tank(
+            "tank",
+            Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.4, 0.5)),
+            open_top,
+            None,
+            None,
+            WallOptions::default(),
+        );
+        let mut b = sim.boundary.clone();
+        // A second frame: rotated 30° about z and moved, as a moving part's frame would be.
+        let (s, c) = 30f64.to_radians().sin_cos();
+        b.frames[0].rot = spatter_core::Mat3::from_cols(
+            Vec3::new(c, s, 0.0),
+            Vec3::new(-s, c, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        );
+        b.frames[0].origin = Vec3::new(0.3, -0.2, 0.1);
+        let inf = f64::INFINITY;
+        let regions = [
+            Aabb::new(Vec3::new(0.2, 0.02, 0.03), Vec3::new(0.5, 0.3, 0.3)),
+            Aabb::new(Vec3::new(-0.1, -0.1, -0.1), Vec3::new(0.05, 0.5, 0.2)),
+            Aabb::new(Vec3::new(5.0, 5.0, 5.0), Vec3::new(6.0, 6.0, 6.0)),
+            Aabb::new(Vec3::new(-inf, -inf, -inf), Vec3::new(0.4, inf, inf)),
+        ];
+        for boundary in [&sim.boundary, &b] {
+            for region in &regions {
+                let reach = 0.06;
+                let mut lw = LocalWalls::default();
+                let (mut src, mut pos) = (Vec::new(), Vec::new());
+                lw.select(boundary, region, reach, &mut src, &mut pos);
+                let want: Vec<u32> = (0..boundary.len())
+                    .filter(|&i| point_gap(boundary.position(i), region) <= reach)
+                    .map(|i| i as u32)
+                    .collect();
+                assert_eq!(src, want, "region {region:?}");
+                assert!(pos.iter().zip(&src).all(|(x, &i)| *x == boundary.position(i as usize)));
+            }
+        }
+        // The cases test something: the first region selects some walls but not all, the third none.
+        let mut lw = LocalWalls::default();
+        let (mut src, mut pos) = (Vec::new(), Vec::new());
+        lw.select(&sim.boundary, &regions[0], 0.06, &mut src, &mut pos);
+        assert!(
+            !src.is_empty() && src.len() < sim.boundary.len() / 2,
+            "{} of {}",
+            src.len(),
+            sim.boundary.len()
+        );
+    }
+}
