@@ -317,6 +317,54 @@ fn periodic_shear_crosses_ranks() {
     assert!((t1 - t4).abs() <= 1e-5 * t1, "time after 400 steps: {t4} s vs {t1} s");
 }
 
+/// A rank whose box empties during a run keeps stepping with the others: a 2D column a × 4a (a = 0.1 m,
+/// 400 particles) split over 4 ranks is cut along its height into four stacked boxes; as it collapses the
+/// upper boxes run dry. Every step keeps every id exactly once, and the run goes on for 200 steps after
+/// the first rank has emptied, with sensors and totals collective as ever.
+#[test]
+fn ranks_whose_boxes_empty_keep_stepping() {
+    let counts = on_ranks(4, |comm| {
+        let a: f64 = 0.1;
+        let g: f64 = 9.81;
+        let dp = a / 10.0;
+        let mut p = SphParams::water(Dim::Two, dp, 10.0 * (2.0 * g * 4.0 * a).sqrt());
+        p.gravity = Vec3::new(0.0, 0.0, -g);
+        let mut sim = Simulation::new(p);
+        sim.add_tank(
+            "tank",
+            Aabb::new(Vec3::ZERO, Vec3::new(8.0 * a, 0.0, 5.0 * a)),
+            OPEN_TOP,
+            None,
+            None,
+            WallOptions::default(),
+        );
+        sim.fill_box(Aabb::new(Vec3::ZERO, Vec3::new(a, 0.0, 4.0 * a)), Vec3::ZERO, true);
+        let total = sim.fluid.len();
+        sim.initialize_with(comm).unwrap();
+        let mut after_empty = None;
+        let mut steps = 0;
+        while after_empty.is_none_or(|s| steps < s + 200) {
+            sim.step_with(comm).unwrap();
+            steps += 1;
+            assert!(steps < 20_000, "no rank emptied");
+            let all = gathered(&sim, comm);
+            assert_eq!(all.len(), total, "particle count at step {steps}");
+            assert!(all.iter().enumerate().all(|(k, e)| e.0 as usize == k), "ids 0..{total} once each");
+            let mut empty = [u64::from(sim.fluid.is_empty())];
+            comm.all_sum_u64(&mut empty);
+            if empty[0] > 0 && after_empty.is_none() {
+                after_empty = Some(steps);
+            }
+        }
+        let mass = total as f64 * sim.params.mass();
+        assert!((sim.fluid_mass_with(comm) - mass).abs() <= 1e-12 * mass, "mass");
+        assert!(sim.kinetic_energy_with(comm).is_finite());
+        sim.fluid.len()
+    });
+    assert_eq!(counts.iter().sum::<usize>(), 400);
+    assert!(counts.contains(&0), "a rank ended without particles: {counts:?}");
+}
+
 /// A particle with a non-finite velocity on one rank: every rank returns the same blow-up error at the
 /// end of the step (no rank left waiting in a collective).
 #[test]
