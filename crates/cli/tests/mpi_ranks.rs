@@ -240,6 +240,21 @@ fn two_ranks_resume_on_two_and_on_one() {
     assert_eq!(err.matches("it needs --resume").count(), 1, "{err}");
 }
 
+/// The processes whose parent is `pid` (from `/proc`).
+fn children(pid: u32) -> Vec<u32> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(p) = e.file_name().to_string_lossy().parse::<u32>() else { continue };
+        let Ok(stat) = std::fs::read_to_string(e.path().join("stat")) else { continue };
+        // pid (comm) state ppid …: the command may hold spaces, so read after its closing parenthesis.
+        let after = &stat[stat.rfind(')').map_or(0, |k| k + 1)..];
+        if after.split_whitespace().nth(1).and_then(|v| v.parse::<u32>().ok()) == Some(pid) {
+            out.push(p);
+        }
+    }
+    out
+}
+
 /// SIGTERM during a run on two ranks, as a batch system sends it at the end of a job's time, both ways it
 /// arrives: (1) to `mpirun`, which delivers it to the ranks `odls_base_sigkill_timeout` seconds later and
 /// kills them as long again after that (OpenMPI 4.1; measured: with 60 s nothing reaches the ranks for a
@@ -286,13 +301,13 @@ fn sigterm_stops_every_rank_with_a_checkpoint_that_resumes_bit_for_bit() {
             std::thread::sleep(Duration::from_millis(50));
         }
         std::thread::sleep(Duration::from_secs(1));
-        let pid = child.id().to_string();
-        let kill = if to_ranks {
-            Command::new("pkill").args(["-TERM", "-P", &pid]).status().unwrap()
-        } else {
-            Command::new("kill").args(["-TERM", &pid]).status().unwrap()
-        };
-        assert!(kill.success(), "{name}: signal sent");
+        let targets = if to_ranks { children(child.id()) } else { vec![child.id()] };
+        assert!(!targets.is_empty(), "{name}: the ranks run");
+        // The shell's own `kill` (no procps needed).
+        let list: Vec<String> = targets.iter().map(u32::to_string).collect();
+        let kill =
+            Command::new("sh").arg("-c").arg(format!("kill -TERM {}", list.join(" "))).status().unwrap();
+        assert!(kill.success(), "{name}: signal sent to {list:?}");
         let status = loop {
             if let Some(s) = child.try_wait().unwrap() {
                 break s;
