@@ -191,6 +191,32 @@ fn results_do_not_depend_on_the_thread_count() {
     assert!(a.0 == b.0 && a.1 == b.1 && a.2 == b.2, "results differ between 1 and 2 threads");
 }
 
+/// Reading the sensors between steps (part loads, a probe, a wall-pressure sensor, the wet area) does not
+/// change the run: the same 60 steps with the sensors read after every 7th step end bit for bit where the
+/// plain run ends (every feature switched on, as in `results_do_not_depend_on_the_thread_count`).
+#[test]
+fn reading_the_sensors_does_not_change_the_run() {
+    let run = |read: bool| {
+        let mut sim = small_dam_break();
+        sim.initialize().unwrap();
+        let mut seen = 0.0;
+        for s in 1..=60 {
+            sim.step().unwrap();
+            if read && s % 7 == 0 {
+                let loads = sim.part_loads();
+                seen += loads[0].force.z;
+                seen += sim.probe(Vec3::new(0.1, 0.1, 0.1)).map_or(0.0, |p| p.0);
+                seen += sim.wall_pressure(Vec3::new(0.0, 0.1, 0.05), 0.03).unwrap_or(0.0);
+                seen += wet_area(&sim, 0, sim.time).wet_now;
+            }
+        }
+        assert!(!read || seen.abs() > 0.0, "the sensors read something");
+        (sim.fluid.pos.clone(), sim.fluid.vel.clone(), sim.fluid.rho.clone(), sim.dt.to_bits())
+    };
+    let (a, b) = (run(false), run(true));
+    assert!(a == b, "reading the sensors changed the run");
+}
+
 /// Water thrown out of a small domain box is removed and counted; the run goes on.
 #[test]
 fn particles_leaving_the_domain_are_counted_not_fatal() {
