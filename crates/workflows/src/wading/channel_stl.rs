@@ -401,8 +401,8 @@ pub(crate) mod tests {
     #[test]
     fn a_centre_line_without_road_is_named() {
         let dir = tempfile::tempdir().unwrap();
-        let (ramp_in, ramp_out): (&[(f64, f64)], &[(f64, f64)]) =
-            (&[(0.0, 0.5), (2.0, 0.0), (4.0, 0.0)], &[(5.0, 0.0), (8.0, 0.0), (10.0, 0.5)]);
+        let ramp_in: &[(f64, f64)] = &[(0.0, 0.5), (2.0, 0.0), (4.0, 0.0)];
+        let ramp_out: &[(f64, f64)] = &[(5.0, 0.0), (8.0, 0.0), (10.0, 0.5)];
         let f = strip_channel(dir.path(), &road_strips(&[ramp_in, ramp_out]));
         let e = StlChannel::read(&f, 0.3).unwrap_err();
         assert_eq!(e.key, "file");
