@@ -20,6 +20,7 @@ pub fn validation_cases() -> Vec<Case> {
         Case { name: "sph_sessile_drop", run: sessile_drop_angles },
         Case { name: "sph_submerged_solid", run: submerged_solid },
         Case { name: "sph_thin_shell_leak", run: thin_shell_leak },
+        Case { name: "sph_wheel_wading", run: crate::wheel_wading::wheel_wading },
     ]
 }
 
@@ -677,6 +678,12 @@ mod tests {
     #[test]
     fn submerged_solid_quick() {
         assert_all_pass(&submerged_solid(true));
+    }
+
+    /// The quick wheel through still water (`crate::wheel_wading`): about 80 CPU-seconds.
+    #[test]
+    fn wheel_wading_quick() {
+        assert_all_pass(&crate::wheel_wading::wheel_wading(true));
     }
 
     #[test]

@@ -2,11 +2,19 @@
 //!
 //! Coordinates as for the generated channel: x along the channel (the direction of travel), y across,
 //! z up. Every solid whose name starts with `road` (`road`, `road_ramp_in`, …) is the road the wheels
-//! roll on; every other solid is a wall of the channel (side walls, end walls, kerbs). All solids become
-//! walls of the SPH scene. The water fills the channel to `water_depth_m` above the road's lowest point;
-//! the still water's extent along x, the end of the pool floor and the centre line across are found from
-//! the road's height along the centre line, by casting rays straight down onto the road's triangles.
+//! roll on; every other solid is a wall of the channel (side walls, end walls). All solids become walls
+//! of the SPH scene. The water fills the channel to `water_depth_m` above the road's lowest point; the
+//! still water's extent along x, the end of the pool floor and the centre line across are found from the
+//! road's height along the centre line, by casting rays straight down onto the road's triangles.
+//!
+//! Checks: every wall must rise above the still water surface — from the file alone a wall that holds
+//! the water cannot be told from one the water would flow over, so a solid the water covers (a low kerb,
+//! an obstacle on the pool floor) is refused as a wall; it belongs to the road (a solid named `road_…`:
+//! the wheels climb it where they meet it, and it is still a wall of the scene). The road must lie under
+//! the whole centre line from its start to its end (else the water would run out through the gap and
+//! the pool search would read the gap as dry ground), and rise above the water at both ends.
 
+use super::bisect::bisect;
 use super::channel::Road;
 use super::parts::{read_parts, NamedPart};
 use spatter_core::mesh::TriMesh;
@@ -65,7 +73,8 @@ pub struct StlChannel {
 impl StlChannel {
     /// Reads `path` (an ASCII STL with named solids) and fills it to `water_depth` \[m\] above the road's
     /// lowest point. Errors name the file and the reason: no file, no solid, a solid without triangles,
-    /// no road solid, no wall solid, water that would run over a wall or out over the road's ends.
+    /// no road solid, no wall solid, water that would run over a wall or out over the road's ends, a
+    /// stretch of the centre line without road.
     pub fn read(path: &Path, water_depth: f64) -> Result<Self, ChannelFileError> {
         let parts = read_parts(path, 1.0).map_err(|e| file_err(e.to_string()))?;
         let is_road = |n: &str| n.starts_with("road");
@@ -107,7 +116,8 @@ impl StlChannel {
                     message: format!(
                         "water_depth_m = {water_depth} m puts the water surface at z = {water_z:.4} m (above the road's \
                          lowest point z = {floor_z} m), over the top of wall `{}` (z = {top} m) of {}: the water \
-                         would run out; lower it or raise the wall",
+                         would run out; lower it or raise the wall (a kerb or obstacle the water may cover \
+                         belongs to the road: name its solid `road_…`)",
                         p.name,
                         path.display()
                     ),
@@ -155,14 +165,16 @@ impl StlChannel {
     }
 
     /// Along the centre line: where the water surface meets the road, the deepest point and the end of
-    /// the pool floor. The road must rise above the water at both ends (else the water would run out
-    /// there), and the water must reach the centre line.
+    /// the pool floor. The road must lie under the whole centre line (a gap is named by
+    /// [`Self::check_gaps`]), rise above the water at both ends (else the water would run out there), and
+    /// the water must reach the centre line.
     fn find_pool(&mut self, path: &Path, depth: f64) -> Result<(), ChannelFileError> {
         let y = self.y_mid();
         let (x0, x1) = self.x_range;
         let xs: Vec<f64> =
             (0..=PROFILE_SAMPLES).map(|i| x0 + (x1 - x0) * i as f64 / PROFILE_SAMPLES as f64).collect();
         let zs: Vec<Option<f64>> = xs.iter().map(|&x| self.road_z(x, y)).collect();
+        self.check_gaps(path, &xs, &zs)?;
         let wet = |z: Option<f64>| z.is_some_and(|z| z < self.water_z);
         let runs_out = |end: &str, x: f64, z: Option<f64>| {
             ChannelFileError {
@@ -196,8 +208,8 @@ impl StlChannel {
             });
         };
         let above = |x: f64| self.road_z(x, y).is_none_or(|z| z >= self.water_z);
-        let x_in = bisect(xs[first - 1], xs[first], above);
-        let x_out = bisect(xs[last + 1], xs[last], above);
+        let x_in = bisect(xs[first - 1], xs[first], above).1;
+        let x_out = bisect(xs[last + 1], xs[last], above).1;
         let (k_deep, z_deep) = zs
             .iter()
             .enumerate()
@@ -205,7 +217,7 @@ impl StlChannel {
             .fold((0, f64::INFINITY), |b, (k, z)| if z < b.1 { (k, z) } else { b });
         let floor = |x: f64| self.road_z(x, y).is_some_and(|z| z <= z_deep + FLOOR_TOLERANCE);
         let k_end = (k_deep..=last).rev().find(|&k| floor(xs[k])).unwrap_or(k_deep);
-        let end = bisect(xs[(k_end + 1).min(PROFILE_SAMPLES)], xs[k_end], |x| !floor(x));
+        let end = bisect(xs[(k_end + 1).min(PROFILE_SAMPLES)], xs[k_end], |x| !floor(x)).1;
         self.waterline = (x_in, x_out);
         self.deepest_x = xs[k_deep];
         self.pool_end_x = end;
@@ -213,21 +225,32 @@ impl StlChannel {
     }
 }
 
-/// The boundary between `out` (where `is_out` holds) and `inside` (where it does not), by bisection to
-/// the last representable number.
-fn bisect(mut out: f64, mut inside: f64, is_out: impl Fn(f64) -> bool) -> f64 {
-    for _ in 0..200 {
-        let mid = 0.5 * (out + inside);
-        if mid == out || mid == inside {
-            break;
-        }
-        if is_out(mid) {
-            out = mid;
-        } else {
-            inside = mid;
-        }
+impl StlChannel {
+    /// The first stretch of the centre line (samples `xs`, road heights `zs`) without road under it, as
+    /// an error naming the file and where it starts and ends (each edge refined by bisection). A road
+    /// that stops short of the road's x extent on the centre line (a wider apron elsewhere sets that
+    /// extent) is such a stretch too. Gaps narrower than the sampling (1/4000 of the road's length) are
+    /// not seen.
+    fn check_gaps(&self, path: &Path, xs: &[f64], zs: &[Option<f64>]) -> Result<(), ChannelFileError> {
+        let Some(k) = zs.iter().position(Option::is_none) else {
+            return Ok(());
+        };
+        let y = self.y_mid();
+        let no_road = |x: f64| self.road_z(x, y).is_none();
+        let from = if k == 0 { xs[0] } else { bisect(xs[k], xs[k - 1], no_road).0 };
+        let to = match zs[k..].iter().position(Option::is_some) {
+            Some(j) => bisect(xs[k + j - 1], xs[k + j], no_road).0,
+            None => xs[xs.len() - 1],
+        };
+        Err(file_err(format!(
+            "{}: no road under the centre line y = {y} m from x = {from:.3} m to x = {to:.3} m (the road \
+             solids reach from x = {} m to {} m): the water would run out through the gap and the wheels \
+             would have nothing to roll on; close the road along the centre line from its start to its end",
+            path.display(),
+            self.x_range.0,
+            self.x_range.1
+        )))
     }
-    inside
 }
 
 impl Road for StlChannel {
@@ -333,6 +356,81 @@ pub(crate) mod tests {
             }
         }
         assert!(s.road_z(-0.1, 0.0).is_none() && s.road_z(3.0, 2.1).is_none());
+    }
+
+    /// Triangles of road strips across y ∈ [−2, 2] m along each profile `(x, z)` (corners joined by
+    /// straight pieces), facing up.
+    fn road_strips(profiles: &[&[(f64, f64)]]) -> Vec<Vec3> {
+        let mut soup = Vec::new();
+        for prof in profiles {
+            for w in prof.windows(2) {
+                let ((x0, z0), (x1, z1)) = (w[0], w[1]);
+                let (a, b) = (Vec3::new(x0, -2.0, z0), Vec3::new(x1, -2.0, z1));
+                let (c, d) = (Vec3::new(x1, 2.0, z1), Vec3::new(x0, 2.0, z0));
+                soup.extend([a, b, c, a, c, d]);
+            }
+        }
+        soup
+    }
+
+    /// Writes a channel file of the road triangles `road` and side walls 1.5 m high at y = ±2 m over
+    /// x ∈ [0, 10] m; returns its path.
+    fn strip_channel(dir: &Path, road: &[Vec3]) -> std::path::PathBuf {
+        let wall = |y: f64| {
+            let p = |x: f64, z: f64| Vec3::new(x, y, z);
+            let (a, b, c, d) = (p(0.0, 0.0), p(10.0, 0.0), p(10.0, 1.5), p(0.0, 1.5));
+            if y > 0.0 {
+                [a, b, c, a, c, d]
+            } else {
+                [a, d, c, a, c, b]
+            }
+        };
+        let walls: Vec<Vec3> = wall(2.0).into_iter().chain(wall(-2.0)).collect();
+        let (a, b) = (dir.join("road_part.stl"), dir.join("walls_part.stl"));
+        write_stl(&a, "road", &TriMesh::from_triangle_soup(road)).unwrap();
+        write_stl(&b, "walls", &TriMesh::from_triangle_soup(&walls)).unwrap();
+        let f = dir.join("channel.stl");
+        let text = std::fs::read_to_string(&a).unwrap() + &std::fs::read_to_string(&b).unwrap();
+        std::fs::write(&f, text).unwrap();
+        f
+    }
+
+    /// A road with a 1 m gap under the centre line (x = 4 … 5 m) and a road that starts on the centre
+    /// line 1 m after its apron at the side: both are refused, naming the file and the stretch without
+    /// road (edges to the 3 decimals printed); closing the gap makes the same file read.
+    #[test]
+    fn a_centre_line_without_road_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let ramp_in: &[(f64, f64)] = &[(0.0, 0.5), (2.0, 0.0), (4.0, 0.0)];
+        let ramp_out: &[(f64, f64)] = &[(5.0, 0.0), (8.0, 0.0), (10.0, 0.5)];
+        let f = strip_channel(dir.path(), &road_strips(&[ramp_in, ramp_out]));
+        let e = StlChannel::read(&f, 0.3).unwrap_err();
+        assert_eq!(e.key, "file");
+        assert!(
+            e.message.contains(
+                "channel.stl: no road under the centre line y = 0 m from x = 4.000 m to x = 5.000 m"
+            ),
+            "{}",
+            e.message
+        );
+        assert!(e.message.contains("the water would run out through the gap"), "{}", e.message);
+        let f = strip_channel(dir.path(), &road_strips(&[ramp_in, &[(4.0, 0.0), (5.0, 0.0)], ramp_out]));
+        let s = StlChannel::read(&f, 0.3).unwrap();
+        assert!(
+            (s.waterline.0 - 0.8).abs() < 1e-9 && (s.waterline.1 - 9.2).abs() < 1e-9,
+            "{:?}",
+            s.waterline
+        );
+        // On the centre line the road starts at x = 1 m; an apron at the side starts at x = 0.
+        let mut road = road_strips(&[&[(1.0, 0.5), (3.0, 0.0), (8.0, 0.0), (10.0, 0.5)]]);
+        let p = |x: f64, y: f64| Vec3::new(x, y, 0.5);
+        road.extend([p(0.0, 1.0), p(1.0, 1.0), p(1.0, 2.0), p(0.0, 1.0), p(1.0, 2.0), p(0.0, 2.0)]);
+        let e = StlChannel::read(&strip_channel(dir.path(), &road), 0.3).unwrap_err();
+        assert!(
+            e.message.contains("from x = 0.000 m to x = 1.000 m (the road solids reach from x = 0 m"),
+            "{}",
+            e.message
+        );
     }
 
     #[test]

@@ -7,8 +7,10 @@
 //! radius, the vehicle is checked against the channel's width and placed on the road ([`vehicle`]); the
 //! speed over time ([`timeline`]); the channel surfaces and the placed parts are written as STL
 //! ([`geometry`]); [`run`] turns all of it into an `sph` scene with motion tables (body pitch and travel,
-//! wheel spin ω = v/R), runs it and writes the wading reports.
+//! wheel spin ω = v/R), runs it and writes the wading reports. Every boundary along one number (a waterline,
+//! a trailing axle, the time a distance is reached) is found by the one bisection of [`bisect`].
 
+pub mod bisect;
 pub mod channel;
 pub mod channel_stl;
 pub mod config;

@@ -8,6 +8,7 @@
 //! Before the first row (t = 0) nothing happens; after the last the vehicle stands at the last point with
 //! its last heading.
 
+use super::bisect::bisect;
 use std::path::Path;
 
 /// One row's optional height: the front axle's height the row demands \[m\], and where the row came
@@ -181,19 +182,9 @@ impl VehiclePath {
                 near = tau;
             }
         }
-        if let Some((mut lo, mut hi)) = found {
-            // `lo` is at least `dist` away, `hi` closer: bisect to the last representable time.
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if mid == lo || mid == hi {
-                    break;
-                }
-                if away(mid) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
+        if let Some((lo, hi)) = found {
+            // `lo` is at least `dist` away, `hi` closer: the last time at least `dist` away.
+            let (lo, _) = bisect(lo, hi, away);
             return self.point(lo);
         }
         // On the straight continuation before the start: P₀ − s u with |P₀ − s u − F| = dist, s ≥ 0.
@@ -283,16 +274,7 @@ impl VehiclePath {
             for j in 1..=64 {
                 let t = w[0] + (w[1] - w[0]) * j as f64 / 64.0;
                 if reached(t) {
-                    let (mut lo, mut hi) = (prev, t);
-                    for _ in 0..100 {
-                        let mid = 0.5 * (lo + hi);
-                        if reached(mid) {
-                            hi = mid;
-                        } else {
-                            lo = mid;
-                        }
-                    }
-                    return Some(hi);
+                    return Some(bisect(prev, t, |t| !reached(t)).1);
                 }
                 prev = t;
             }

@@ -1,5 +1,6 @@
 //! The vehicle's progress over time: a constant speed or a speed table along the channel, or a free path.
 
+use super::bisect::bisect;
 use super::path::VehiclePath;
 use std::path::Path;
 
@@ -167,16 +168,7 @@ impl SpeedProfile {
         while self.distance(hi) < s {
             hi *= 2.0;
         }
-        let mut lo = 0.0;
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if self.distance(mid) < s {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Some(hi)
+        Some(bisect(0.0, hi, |t| self.distance(t) < s).1)
     }
 
     /// Largest speed of the table \[m/s\].

@@ -1,6 +1,7 @@
 //! The vehicle: its part files, its wheels (found by part name, with axle and radius), checks that name
 //! the scenario key of every problem, and its placement on the channel's road.
 
+use super::bisect::bisect;
 use super::channel::{pitch, Road};
 use super::parts::{bounds, wheel_reach, NamedPart};
 use serde::{Deserialize, Serialize};
@@ -187,19 +188,7 @@ pub fn place_on_road(
             + (zf - road.axle_height(xr, yr, rear.radius_m, heading)).powi(2))
         .sqrt()
     };
-    let (mut lo, mut hi) = (x_front - span - 1.0, x_front);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        // Converged: lo and hi are neighbouring numbers, further steps change nothing.
-        if mid == lo || mid == hi {
-            break;
-        }
-        if dist(mid) > span {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    let (lo, hi) = bisect(x_front - span - 1.0, x_front, |xr| dist(xr) > span);
     let x_rear = 0.5 * (lo + hi);
     let y_rear = rear_y(x_rear);
     let zr = road.axle_height(x_rear, y_rear, rear.radius_m, heading);
