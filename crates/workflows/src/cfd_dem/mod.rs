@@ -12,7 +12,8 @@
 //!    it (the same trilinear stencil the velocity is sampled with) as a body force; the momentum the
 //!    fluid receives, Σ ρ V a over the nodes, is compared with the momentum taken from the spheres
 //!    ([`ExchangeReport`]);
-//! 4. **fluid** step Δt_f (explicit source);
+//! 4. **fluid** step Δt_f (explicit source; with [`Exchange::SemiImplicit`] the drag is implicit in the
+//!    fluid velocity and the spheres' forces follow the fluid step, see [`implicit`]);
 //! 5. **DEM**: N steps.
 //!
 //! The fluid solver advances the superficial velocity U = α u with ∇·U = 0 and
