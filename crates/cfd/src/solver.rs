@@ -9,7 +9,8 @@
 //! One step from tⁿ to tⁿ⁺¹ = tⁿ + Δt (Kim & Moin 1985; Brown, Cortez & Minion 2001):
 //! 1. H = −(u·∇)u + ∇·(ν∇u) + f at every interior velocity node (see [`crate::momentum`]);
 //! 2. predictor u* = uⁿ + Δt [(1 + Δt/2Δt₀) Hⁿ − (Δt/2Δt₀) Hⁿ⁻¹] − Δt ∇pⁿ (variable-step AB2; Euler on the
-//!    first step), boundary velocities at tⁿ⁺¹;
+//!    first step), boundary velocities at tⁿ⁺¹; a linear source s − k u ([`Flow::implicit`]) is then
+//!    taken backward-Euler: u* ← (u* + Δt s)/(1 + Δt k);
 //! 3. pressure correction φ from ∇·(∇φ) = ∇·u*/Δt, solved by multigrid-preconditioned CG;
 //! 4. uⁿ⁺¹ = u* − Δt ∇φ (discretely divergence-free to the solver tolerance), pⁿ⁺¹ = pⁿ + φ.
 
@@ -23,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 /// Node kinds.
 const FIXED: u8 = 0;
-const ACTIVE: u8 = 1;
+pub(crate) const ACTIVE: u8 = 1;
 const OUTLET: u8 = 2;
 
 /// Fluid properties.
@@ -114,6 +115,9 @@ pub struct Flow {
     pub blocked: Vec<bool>,
     /// Body acceleration at the velocity nodes \[m/s²\] (actuator disks, particles), if any.
     pub force: Option<[Vec<f64>; 3]>,
+    /// A linear source s − k u taken implicitly by the predictor (the particles' drag of a semi-implicit
+    /// coupling), if any; see [`crate::sources::ImplicitSource`].
+    pub implicit: Option<crate::sources::ImplicitSource>,
     /// The k–ε model, when enabled ([`Flow::enable_k_epsilon`]).
     pub turbulence: Option<crate::turbulence::Turbulence>,
     kind: [Vec<u8>; 3],
@@ -259,6 +263,7 @@ impl Flow {
             state,
             blocked,
             force: None,
+            implicit: None,
             turbulence: None,
             kind,
             solid_nodes,
@@ -297,6 +302,10 @@ impl Flow {
         let mut n = f64s(&st.u) + st.p.capacity() + f64s(&st.h_old) + f64s(&self.h_new);
         n += self.phi.capacity() + self.rhs.capacity();
         n += self.force.as_ref().map_or(0, f64s);
+        n += self
+            .implicit
+            .as_ref()
+            .map_or(0, |i| f64s(&i.k) + f64s(&i.s) + f64s(&i.u_star) + f64s(&i.applied));
         if let Some(t) = &self.state.turbulence {
             n += t.k.capacity() + t.eps.capacity();
         }
@@ -546,6 +555,9 @@ impl Flow {
                     }
                 }
             });
+            if let Some(src) = self.implicit.as_mut() {
+                src.advance(a, &l, kind, dt, &mut self.state.u[a]);
+            }
             for &(c, src) in &self.outlet_nodes[a] {
                 self.state.u[a][c] = self.state.u[a][src];
             }

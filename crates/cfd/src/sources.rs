@@ -64,6 +64,59 @@ impl ActuatorDisk {
     }
 }
 
+/// A linear momentum source per unit mass, a = s − k u \[m/s²\], at the velocity nodes, which the
+/// predictor takes implicitly in u (backward Euler, outside the Adams–Bashforth terms):
+/// u* ← (u* + Δt s)/(1 + Δt k). It is the particles' drag of a semi-implicit coupling, −β (u − v)/(ρV)
+/// with k = β/(ρV) on the diagonal and s = β v/(ρV) explicit (the `Ksl`/`Us` form of CFDEM's implicit
+/// drag); a large k Δt relaxes u towards s/k without overshoot, where an explicit source would
+/// oscillate. The fluid receives ρ V (s − k u*) Δt per node over a step, which [`ImplicitSource::applied`]
+/// holds after it. The source stays until it is changed ([`Flow::implicit_source`] clears it).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImplicitSource {
+    /// Coefficient k ≥ 0 per velocity node \[1/s\].
+    pub k: [Vec<f64>; 3],
+    /// Explicit part s per velocity node \[m/s²\].
+    pub s: [Vec<f64>; 3],
+    /// After a step: the predictor velocity u* the source was evaluated with \[m/s\] (active nodes with
+    /// a source; 0 elsewhere).
+    pub u_star: [Vec<f64>; 3],
+    /// After a step: the acceleration applied, s − k u* \[m/s²\] (active nodes with a source; 0
+    /// elsewhere).
+    pub applied: [Vec<f64>; 3],
+}
+
+impl ImplicitSource {
+    fn zeros(n: usize) -> [Vec<f64>; 3] {
+        [vec![0.0; n], vec![0.0; n], vec![0.0; n]]
+    }
+
+    /// Takes the source implicitly at the active nodes of component `a` of `u` (the predictor velocity
+    /// before the outlet nodes copy their neighbours), recording u* and the applied acceleration.
+    pub(crate) fn advance(
+        &mut self,
+        a: usize,
+        l: &crate::grid::Layout,
+        active: &[u8],
+        dt: f64,
+        u: &mut [f64],
+    ) {
+        let (k, s) = (&self.k[a], &self.s[a]);
+        let (us, ap) = (&mut self.u_star[a], &mut self.applied[a]);
+        // Sequential over the padded nodes: one formula per node, so the order does not matter.
+        for c in 0..l.len() {
+            if active[c] != crate::solver::ACTIVE || (k[c] == 0.0 && s[c] == 0.0) {
+                us[c] = 0.0;
+                ap[c] = 0.0;
+                continue;
+            }
+            let v = (u[c] + dt * s[c]) / (1.0 + dt * k[c]);
+            u[c] = v;
+            us[c] = v;
+            ap[c] = s[c] - k[c] * v;
+        }
+    }
+}
+
 /// Why a source could not be placed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SourceError {
@@ -281,10 +334,36 @@ impl Flow {
         }
     }
 
+    /// The implicit source, created (zero) on first use and cleared: k, s, u* and the applied
+    /// acceleration all 0, ready to be filled for the next step.
+    pub fn implicit_source(&mut self) -> &mut ImplicitSource {
+        let n = self.grid.layout.len();
+        let src = self.implicit.get_or_insert_with(|| ImplicitSource {
+            k: ImplicitSource::zeros(n),
+            s: ImplicitSource::zeros(n),
+            u_star: ImplicitSource::zeros(n),
+            applied: ImplicitSource::zeros(n),
+        });
+        for v in [&mut src.k, &mut src.s, &mut src.u_star, &mut src.applied] {
+            v.iter_mut().for_each(|a| a.iter_mut().for_each(|x| *x = 0.0));
+        }
+        src
+    }
+
     /// Total force the body-force field exerts on the fluid, Σ ρ V a over the active nodes \[N\] (per
     /// radian when axisymmetric).
     pub fn total_body_force(&self) -> [f64; 3] {
-        let Some(force) = &self.force else { return [0.0; 3] };
+        self.total_of(self.force.as_ref())
+    }
+
+    /// Total force the implicit source applied in the last step, Σ ρ V (s − k u*) over the active nodes
+    /// \[N\] (per radian when axisymmetric); the fluid gained this times Δt of momentum from it.
+    pub fn total_implicit_force(&self) -> [f64; 3] {
+        self.total_of(self.implicit.as_ref().map(|i| &i.applied))
+    }
+
+    fn total_of(&self, force: Option<&[Vec<f64>; 3]>) -> [f64; 3] {
+        let Some(force) = force else { return [0.0; 3] };
         let l = self.grid.layout;
         let rho = self.fluid.density;
         // Active nodes are interior cells' +faces: a sum over interior cells, plane by plane in order.
@@ -521,5 +600,48 @@ mod tests {
         assert_eq!(f.add_actuator_disk(&outside), Err(SourceError::Outside(3.0)));
         let tiny = ActuatorDisk { radius_m: 0.01, ..disk };
         assert_eq!(f.add_actuator_disk(&tiny), Err(SourceError::NoCells(0.01)));
+    }
+
+    /// A stiff uniform drag on a channel open at both ends (static-pressure outlets, slip sides): with
+    /// the same s and k at every x-node the flow stays uniform and pressure-free, so each step is exactly
+    /// the backward-Euler recursion u ← (u + Δt s)/(1 + Δt k), which approaches s/k monotonically even at
+    /// k Δt = 50, where an explicit source (u ← u + Δt (s − k u)) would multiply the distance by −49 per
+    /// step. The momentum the fluid receives is Σ ρ V (s − k u*) (exact to round-off, 1e-12).
+    #[test]
+    fn an_implicit_linear_source_relaxes_a_uniform_flow_by_backward_euler() {
+        let g = Grid::uniform_box([0.0; 3], [4.0, 1.0, 1.0], [8, 2, 2]).unwrap();
+        let out = || Boundary::Outlet { pressure_pa: 0.0 };
+        let bc = [out(), out(), Boundary::Slip, Boundary::Slip, Boundary::Slip, Boundary::Slip];
+        let blocked = vec![false; g.layout.len()];
+        let mut f =
+            Flow::new(g, Fluid { density: 2.0, viscosity: 1e-3 }, bc, blocked, Numerics::default()).unwrap();
+        let (k, s, dt) = (500.0, 1000.0, 0.1);
+        let mut want = 0.0f64;
+        for step in 0..6 {
+            let l = f.grid.layout;
+            let active: Vec<usize> = (0..l.len()).filter(|&c| f.is_active_node(0, c)).collect();
+            assert_eq!(active.len(), 7 * 2 * 2);
+            let src = f.implicit_source();
+            for &c in &active {
+                src.k[0][c] = k;
+                src.s[0][c] = s;
+            }
+            f.step(dt).unwrap();
+            let before = want;
+            want = (want + dt * s) / (1.0 + dt * k);
+            for &c in &active {
+                assert!(
+                    (f.state.u[0][c] / want - 1.0).abs() < 1e-12,
+                    "step {step}: {} vs {want}",
+                    f.state.u[0][c]
+                );
+            }
+            // Monotone: every step closes part of the gap to s/k = 2 m/s, never crossing it.
+            assert!(want > before && want < s / k, "step {step}: {want}");
+            let got = f.total_implicit_force()[0];
+            let expect = 2.0 * 28.0 * 0.125 * (s - k * want); // ρ × 28 nodes × 0.5³ m³
+            assert!((got / expect - 1.0).abs() < 1e-12, "{got} vs {expect}");
+        }
+        assert!((want - s / k).abs() < 1e-6 * s / k, "{want}");
     }
 }

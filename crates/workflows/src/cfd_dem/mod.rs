@@ -12,7 +12,8 @@
 //!    it (the same trilinear stencil the velocity is sampled with) as a body force; the momentum the
 //!    fluid receives, Σ ρ V a over the nodes, is compared with the momentum taken from the spheres
 //!    ([`ExchangeReport`]);
-//! 4. **fluid** step Δt_f (explicit source);
+//! 4. **fluid** step Δt_f (explicit source; with [`Exchange::SemiImplicit`] the drag is implicit in the
+//!    fluid velocity and the spheres' forces follow the fluid step, see [`implicit`]);
 //! 5. **DEM**: N steps.
 //!
 //! The fluid solver advances the superficial velocity U = α u with ∇·U = 0 and
@@ -27,6 +28,7 @@
 
 pub mod config;
 pub mod exchange;
+pub mod implicit;
 pub mod partner;
 pub mod run;
 #[cfg(test)]
@@ -37,6 +39,7 @@ pub mod void_fraction;
 use crate::fluid_forces::{FluidForceOptions, FluidSampler};
 pub use config::CfdDemConfig;
 use exchange::{pressure_gradient_nodes, GridFluid};
+pub use implicit::Exchange;
 use rayon::prelude::*;
 pub use run::{run, CfdDemError};
 use serde::{Deserialize, Serialize};
@@ -73,6 +76,9 @@ pub struct CouplingOptions {
     pub forces: FluidForceOptions,
     #[serde(default)]
     pub model: MomentumModel,
+    /// Explicit (default) or semi-implicit exchange ([`implicit`]).
+    #[serde(default)]
+    pub exchange: Exchange,
     #[serde(default)]
     pub void_fraction: VoidFractionMethod,
     /// Lower clamp of the void fraction (default 0.3).
@@ -95,6 +101,7 @@ impl Default for CouplingOptions {
         CouplingOptions {
             forces: FluidForceOptions::default(),
             model: MomentumModel::A,
+            exchange: Exchange::Explicit,
             void_fraction: VoidFractionMethod::Divided,
             alpha_min: default_alpha_min(),
             dem_steps_per_fluid_step: default_substeps(),
@@ -201,8 +208,14 @@ pub struct Coupling {
     /// The spheres' forces of the current step \[N\] (exchanged + buoyancy).
     on_particles: Vec<Vec3>,
     inside: Vec<bool>,
-    /// The node shares of each sphere's exchanged force (`None`: outside the grid).
+    /// The node shares of each sphere's exchanged force (`None`: outside the grid); of a unit force
+    /// in the semi-implicit exchange.
     shares: Vec<Option<spatter_cfd::sources::PointForce>>,
+    /// Semi-implicit exchange: each sphere's linearised force of the current step.
+    linear: Vec<implicit::Linear>,
+    /// Semi-implicit exchange: each sphere's force carried by boundary faces \[N\] and the size of its
+    /// terms \[N\] (the scale of its momentum balance).
+    carried: Vec<(Vec3, f64)>,
     pub times: CouplingTimes,
     pub last: ExchangeReport,
 }
@@ -247,6 +260,8 @@ impl Coupling {
             on_particles: Vec::new(),
             inside: Vec::new(),
             shares: Vec::new(),
+            linear: Vec::new(),
+            carried: Vec::new(),
             times: CouplingTimes::default(),
             last: ExchangeReport::default(),
         })
@@ -273,7 +288,8 @@ impl Coupling {
 
     /// Void fraction, forces and exchange at the current state of `dem` (steps 1–3 of a coupling step),
     /// without stepping; the forces on the spheres become `dem`'s persistent external forces. Returns
-    /// the momentum balance.
+    /// the momentum balance. This is the explicit exchange; with `exchange = semi_implicit` a coupling
+    /// step recomputes every force around its fluid step, so this serves for outputs only.
     pub fn exchange<L: ContactLaw>(&mut self, dem: &mut Simulation<L>) -> ExchangeReport {
         let t0 = Instant::now();
         let p = &dem.particles;
@@ -391,11 +407,32 @@ impl Coupling {
         if dt > limit {
             return Err(CouplingError::FluidStep { dt, limit, t: self.flow.state.t });
         }
-        let rep = self.exchange(dem);
-        let t0 = Instant::now();
-        let frep = self.flow.step(dt)?;
-        self.times.fluid += t0.elapsed().as_secs_f64();
-        Ok((rep, frep))
+        match self.options.exchange {
+            Exchange::Explicit => {
+                let rep = self.exchange(dem);
+                let t0 = Instant::now();
+                let frep = self.flow.step(dt)?;
+                self.times.fluid += t0.elapsed().as_secs_f64();
+                Ok((rep, frep))
+            }
+            Exchange::SemiImplicit => {
+                self.prepare_implicit(dem, dt);
+                let t0 = Instant::now();
+                let frep = self.flow.step(dt)?;
+                self.times.fluid += t0.elapsed().as_secs_f64();
+                Ok((self.finish_implicit(dem), frep))
+            }
+        }
+    }
+
+    /// The acceleration \[m/s²\] the spheres put into the fluid at each velocity node at the last
+    /// exchange: the explicit body force, or the applied implicit source s − k u* of the last
+    /// semi-implicit step (`None` before any exchange).
+    pub fn momentum_source(&self) -> Option<&[Vec<f64>; 3]> {
+        match (&self.flow.implicit, self.options.exchange) {
+            (Some(src), Exchange::SemiImplicit) => Some(&src.applied),
+            _ => self.flow.force.as_ref(),
+        }
     }
 }
 

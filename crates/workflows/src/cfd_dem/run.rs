@@ -512,7 +512,7 @@ pub(super) fn coupling_cells(c: &super::Coupling) -> (Vec<f64>, Vec<[f64; 3]>) {
             for i in 0..l.n[0] {
                 let cell = l.cell(i, j, k);
                 alpha.push(c.void_fraction().alpha[cell]);
-                src.push(match &flow.force {
+                src.push(match c.momentum_source() {
                     Some(f) if !flow.blocked[cell] => {
                         [0, 1, 2].map(|a| 0.5 * rho * (f[a][cell] + f[a][cell - l.s[a]]))
                     }

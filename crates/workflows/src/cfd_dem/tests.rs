@@ -9,9 +9,17 @@ use spatter_dem::NewParticle;
 #[test]
 fn the_fluid_receives_exactly_the_momentum_the_spheres_lose() {
     // 300 spheres scattered through a moving fluid with a pressure field, models A and B, both
-    // void-fraction methods: Σ ρ V a over the velocity nodes = −Σ F_exchanged over the spheres to
-    // round-off (1e-12 relative; the two sums run in different orders).
-    for model in [MomentumModel::A, MomentumModel::B] {
+    // void-fraction methods, explicit and semi-implicit exchange: Σ ρ V a over the velocity nodes =
+    // −Σ F_exchanged over the spheres to round-off (1e-12 relative; the two sums run in different
+    // orders). Semi-implicit, a is the applied s − k u* of the fluid step and F the force each sphere
+    // got from the same u* (the momentum the fluid gained over the step over Δt), measured against the
+    // size of the terms (both are differences of larger terms).
+    for (model, exchange) in [
+        (MomentumModel::A, Exchange::Explicit),
+        (MomentumModel::B, Exchange::Explicit),
+        (MomentumModel::A, Exchange::SemiImplicit),
+        (MomentumModel::B, Exchange::SemiImplicit),
+    ] {
         for vf in [VoidFractionMethod::CellCentre, VoidFractionMethod::Divided] {
             let inlet = Boundary::Inlet { velocity_m_s: [0.0, 0.0, 0.01], table: Default::default() };
             let outlet = Boundary::Outlet { pressure_pa: 0.0 };
@@ -27,12 +35,15 @@ fn the_fluid_receives_exactly_the_momentum_the_spheres_lose() {
                 p.vel = Vec3::new(0.01, -0.02, 0.03 * ((k % 3) as f64 - 1.0));
                 d.add_particle(p);
             }
-            let opts = CouplingOptions { model, void_fraction: vf, ..Default::default() };
+            let opts = CouplingOptions { model, exchange, void_fraction: vf, ..Default::default() };
             let mut c = Coupled::new(f, d, opts).unwrap();
             let rep = c.step().unwrap();
             assert_eq!(rep.outside, 0);
             assert!(rep.from_particles.length() > 0.0);
-            assert!(rep.relative_mismatch < 1e-12, "{model:?} {vf:?}: {rep:?}");
+            assert!(rep.relative_mismatch < 1e-12, "{model:?} {exchange:?} {vf:?}: {rep:?}");
+            // The spheres carry the same forces the report sums (the DEM's external forces).
+            let ext: Vec3 = c.dem.particles.ext_force.iter().copied().sum();
+            assert!(ext.length() > 0.0);
             let rep = c.exchange();
             assert!(rep.relative_mismatch < 1e-12, "{model:?} {vf:?} after a step: {rep:?}");
         }
@@ -41,6 +52,16 @@ fn the_fluid_receives_exactly_the_momentum_the_spheres_lose() {
 
 #[test]
 fn a_fixed_bed_has_the_ergun_pressure_drop() {
+    fixed_bed_against_ergun(Exchange::Explicit);
+}
+
+#[test]
+fn a_fixed_bed_has_the_ergun_pressure_drop_with_the_semi_implicit_exchange() {
+    // The same bed and tolerance with the drag implicit in the fluid (frozen spheres: φ = 1).
+    fixed_bed_against_ergun(Exchange::SemiImplicit);
+}
+
+fn fixed_bed_against_ergun(exchange: Exchange) {
     // Ergun (1952) at Re_p = ρ U d/μ = 2 and 20 (both terms of the law matter), both momentum models:
     // the measured pressure gradient inside the bed within 1 % of Ergun's with the bed's ε (the drag law
     // is Gidaspow's Ergun branch, so this checks the void fraction, the interstitial velocity U/ε and
@@ -49,10 +70,10 @@ fn a_fixed_bed_has_the_ergun_pressure_drop() {
     let mut results = Vec::new();
     for model in [MomentumModel::B, MomentumModel::A] {
         for u in [2e-3, 2e-2] {
-            let (grad, eps) = fixed_bed(model, u).unwrap();
+            let (grad, eps) = fixed_bed(model, exchange, u).unwrap();
             assert!((eps - eps_lattice).abs() < 1e-12, "ε = {eps}");
             let want = ergun(eps, u, 1e-3, &water());
-            eprintln!("{model:?} U = {u}: dp/dz = {grad:.2} Pa/m, Ergun {want:.2}");
+            eprintln!("{model:?} {exchange:?} U = {u}: dp/dz = {grad:.2} Pa/m, Ergun {want:.2}");
             results.push((model, u, grad, want));
         }
     }
@@ -63,6 +84,17 @@ fn a_fixed_bed_has_the_ergun_pressure_drop() {
 
 #[test]
 fn a_sphere_settles_at_the_schiller_naumann_terminal_velocity_with_two_way_coupling() {
+    settling_against_schiller_naumann(Exchange::Explicit);
+}
+
+#[test]
+fn a_sphere_settles_at_the_schiller_naumann_terminal_velocity_with_the_semi_implicit_exchange() {
+    // The same bead and tolerances with the drag implicit in the fluid and step-averaged for the bead
+    // (x = βΔt_f/m ≈ 0.004 here; at the terminal velocity the step average keeps the drag exact).
+    settling_against_schiller_naumann(Exchange::SemiImplicit);
+}
+
+fn settling_against_schiller_naumann(exchange: Exchange) {
     // A 1 mm glass bead (ρ = 2500) released from rest in a closed box of water, cells of 3 mm (3 d, the
     // usual lower limit of unresolved coupling), models A and B. The fluid the bead drags along is the
     // coupling's cell-size error: it leaves each cell after h/w_t ≈ 0.02 s having given it an impulse
@@ -73,8 +105,10 @@ fn a_sphere_settles_at_the_schiller_naumann_terminal_velocity_with_two_way_coupl
     // Fluid step 1e-4 s: the solver's explicit steps with a concentrated body force in a closed box
     // grow unstable at 1e-3 s here (see docs/cfd.md, section 13).
     for model in [MomentumModel::A, MomentumModel::B] {
-        let (v, s, wt) = settling(model).unwrap();
-        eprintln!("{model:?}: settling {v:.5} m/s, slip {s:.5} m/s, Schiller–Naumann {wt:.5} m/s");
+        let (v, s, wt) = settling(model, exchange).unwrap();
+        eprintln!(
+            "{model:?} {exchange:?}: settling {v:.5} m/s, slip {s:.5} m/s, Schiller–Naumann {wt:.5} m/s"
+        );
         assert!((v / wt - 1.0).abs() < 0.03, "{model:?}: {v} vs {wt}");
         if model == MomentumModel::A {
             // Model B gives the sphere drag/α (α ≈ 0.98 here), so its slip is ~1 % below w_t.
@@ -152,4 +186,144 @@ fn a_free_bed_on_the_inlet_has_ergun_pressure_drop_and_fluidises_at_ergun_balanc
     }
     assert!(checks.len() >= 4, "{checks:?}");
     assert!(checks.iter().all(|c| c.passed()), "{checks:?}");
+}
+
+/// A uniform suspension relaxing its slip: water in a channel of 8 × 2 × 2 cells of h = 0.1 mm, open at
+/// both x ends (static-pressure outlets), slip sides; one glass sphere of d = 0.9 h (2500 kg/m³) on every
+/// interior x-face at the centre of its y–z cell, so that each sphere's stencil is the one velocity node
+/// it sits on and every node carries one sphere (void fraction α = 1 − π(0.9)³/6 = 0.618 booked by cell
+/// centre), no gravity. The spheres start at v₀ = 10⁻⁷ m/s in still water (so slowly that they move by
+/// under 10⁻⁶ h while they relax: their stencils stay on their nodes to 10⁻⁶); drag `ergun_wen_yu` (Re_p
+/// ≈ 10⁻⁵: β is the Stokes-like Ergun term, constant). Returns per coupling step (t, slip u − v, U at a
+/// node, v) \[s, m/s\], or the error that stopped the run, and the per-node constants (β, m, α, ρ_f V).
+const V0: f64 = 1e-7;
+
+/// (t, slip u − v, U at a node, v) after a coupling step \[s, m/s\].
+type Sample = (f64, f64, f64, f64);
+
+fn uniform_suspension(
+    exchange: Exchange,
+    dt_f: f64,
+    steps: usize,
+) -> (Vec<Sample>, Option<String>, [f64; 4]) {
+    use spatter_cfd::grid::GHOST;
+    let h = 1e-4;
+    let out = || Boundary::Outlet { pressure_pa: 0.0 };
+    let bc = [out(), out(), Boundary::Slip, Boundary::Slip, Boundary::Slip, Boundary::Slip];
+    let f = flow([8, 2, 2], h, bc).unwrap();
+    let faces = f.grid.axes[0].faces();
+    let (yc, zc) = ([0, 1].map(|j| f.grid.axes[1].centre(j)), [0, 1].map(|k| f.grid.axes[2].centre(k)));
+    let mut d = dem(dt_f / 10.0);
+    d.gravity = Vec3::ZERO;
+    let v0 = V0;
+    for &x in &faces[1..8] {
+        for y in yc {
+            for z in zc {
+                let mut p = NewParticle::at(Vec3::new(x, y, z), 0.45 * h, 0);
+                p.vel = Vec3::new(v0, 0.0, 0.0);
+                d.add_particle(p);
+            }
+        }
+    }
+    let opts = CouplingOptions {
+        forces: FluidForceOptions { drag: crate::fluid_forces::DragModel::ErgunWenYu, ..Default::default() },
+        exchange,
+        void_fraction: VoidFractionMethod::CellCentre,
+        ..Default::default()
+    };
+    let mut c = Coupled::new(f, d, opts).unwrap();
+    let l = c.flow.grid.layout;
+    let node = l.at(GHOST + 3, GHOST, GHOST); // the u-node on face 4 of row (0, 0)
+    let mut out = Vec::new();
+    let mut err = None;
+    for _ in 0..steps {
+        match c.step() {
+            Ok(rep) => assert!(rep.relative_mismatch < 1e-12, "{exchange:?}: {rep:?}"),
+            Err(e) => {
+                err = Some(e.to_string());
+                break;
+            }
+        }
+        let alpha = c.last.alpha_min;
+        let u = c.flow.state.u[0][node];
+        let v = c.dem.particles.vel[0].x;
+        // Every sphere moves alike (uniform suspension; the explicit exchange amplifies round-off).
+        if exchange == Exchange::SemiImplicit {
+            for p in &c.dem.particles.vel {
+                assert!((p.x - v).abs() <= 1e-6 * v.abs().max(v0), "{p} vs {v}");
+            }
+        }
+        out.push((c.flow.state.t, u / alpha - v, u, v));
+    }
+    let alpha = c.last.alpha_min;
+    let r = 0.45 * h;
+    let m = 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let fl = spatter_flow::forces::Fluid { density: 1000.0, viscosity: 1e-3 };
+    let beta = crate::fluid_forces::DragModel::ErgunWenYu.beta(&fl, 2.0 * r, alpha, 0.0);
+    (out, err, [beta, m, alpha, 1000.0 * h * h * h])
+}
+
+/// Two-way relaxation of a uniform suspension (the two-fluid momentum balance, e.g. Crowe, Schwarzkopf,
+/// Sommerfeld & Tsuji, *Multiphase Flows with Droplets and Particles*, ch. 4): per velocity node of
+/// volume V holding one sphere of mass m, ρ_f V dU/dt = −β (U/α − v) and m dv/dt = β (U/α − v) (U the
+/// solver's superficial velocity, U/α the interstitial one), so the slip s = U/α − v decays as
+/// s(t) = s₀ exp(−λ t), λ = β (1/(α ρ_f V) + 1/m) — with n = 1/V spheres per volume,
+/// λ = β_V (1/(α ρ_f) + 1/(ρ_p (1 − α))), β_V = nβ — and both phases end at the common velocity
+/// v_∞ = m v₀/(α ρ_f V + m) (the momentum Σ ρ_f V U + m v is conserved).
+///
+/// Here λ = 1.16·10⁴ 1/s (τ_p = m/β = 0.22 ms). At Δt_f = 0.5 ms (2.3 τ_p, λΔt_f = 5.8) the explicit
+/// exchange multiplies the slip by 1 − λΔt_f ≈ −4.8 per step (overshoot and growth) while the
+/// semi-implicit one shrinks it monotonically, without a change of sign, to v_∞ (to 10⁻⁶: the spheres'
+/// drift moves a part of their stencil onto the outlet faces, which carry it). At
+/// Δt_f = 1 µs (λΔt_f = 0.012) the semi-implicit slip follows s₀ exp(−λt) within 3 % of s₀ e^(−λt)
+/// at λt = 1, 2, 3 (the scheme is first order in Δt_f).
+#[test]
+fn a_heavily_loaded_suspension_relaxes_its_slip_monotonically_with_the_semi_implicit_exchange() {
+    let (steps, err, [beta, m, alpha, rho_v]) = uniform_suspension(Exchange::Explicit, 5e-4, 6);
+    let lambda = beta * (1.0 / (alpha * rho_v) + 1.0 / m);
+    eprintln!("β = {beta:e} kg/s, m = {m:e} kg, α = {alpha}, λ = {lambda:.1} 1/s, τ_p = {:e} s", m / beta);
+    eprintln!("explicit at 0.5 ms: {steps:?}, {err:?}");
+    assert!((lambda * 5e-4 - 5.8).abs() < 0.1, "λ = {lambda}");
+    // Explicit: the slip changes sign at once and grows (or the fluid step is refused as unstable).
+    assert!(err.is_some() || steps.iter().any(|s| s.1 > 0.0), "{steps:?}");
+    assert!(err.is_some() || steps.last().unwrap().1.abs() > 100.0 * V0, "{steps:?}");
+
+    let (steps, err, _) = uniform_suspension(Exchange::SemiImplicit, 5e-4, 12);
+    eprintln!("semi-implicit at 0.5 ms: {steps:?}");
+    assert!(err.is_none(), "{err:?}");
+    let v0 = V0;
+    let v_inf = m * v0 / (alpha * rho_v + m);
+    let mut last = -v0;
+    for &(t, s, u, v) in &steps {
+        if last.abs() < 1e-8 * v0 {
+            break; // relaxed to the floor set by the spheres' drift off their nodes (~10⁻⁶ h)
+        }
+        assert!(s < 0.0 && s > last, "t = {t}: slip {s} after {last}");
+        assert!(v >= v_inf * (1.0 - 1e-6) && u / alpha <= v_inf * (1.0 + 1e-6), "t = {t}: {u} {v}");
+        last = s;
+    }
+    let &(_, s, u, v) = steps.last().unwrap();
+    assert!((v / v_inf - 1.0).abs() < 1e-6 && (u / alpha / v_inf - 1.0).abs() < 1e-6, "{u} {v} vs {v_inf}");
+    assert!(s.abs() < 1e-8 * v0, "{s}");
+
+    let dt = 1e-6;
+    let n = (3.0 / (lambda * dt)).ceil() as usize + 1;
+    let (steps, err, _) = uniform_suspension(Exchange::SemiImplicit, dt, n);
+    assert!(err.is_none(), "{err:?}");
+    for k in [1.0, 2.0, 3.0] {
+        let &(t, s, _, _) = steps.iter().find(|st| st.0 * lambda >= k).unwrap();
+        let want = -V0 * (-lambda * t).exp();
+        eprintln!("λt = {:.3}: slip {s:e}, exp {want:e} ({:+.2} %)", lambda * t, 100.0 * (s / want - 1.0));
+        assert!((s / want - 1.0).abs() < 0.03, "λt = {k}: {s} vs {want}");
+    }
+}
+
+#[test]
+fn the_exchange_key_takes_explicit_or_semi_implicit_and_names_both_otherwise() {
+    let ok: CouplingOptions = toml::from_str("exchange = \"semi_implicit\"").unwrap();
+    assert_eq!(ok.exchange, Exchange::SemiImplicit);
+    assert_eq!(CouplingOptions::default().exchange, Exchange::Explicit);
+    let err = toml::from_str::<CouplingOptions>("exchange = \"implicit\"").unwrap_err().to_string();
+    assert!(err.contains("exchange") || err.contains("implicit"), "{err}");
+    assert!(err.contains("explicit") && err.contains("semi_implicit"), "{err}");
 }

@@ -73,7 +73,7 @@ pub(crate) fn lattice_porosity() -> f64 {
 /// spheres, so ε is uniform), water entering at the bottom with superficial velocity `u` \[m/s\], drag
 /// `ergun_wen_yu`. Returns the pressure gradient inside the bed \[Pa/m\] after 0.05 s (fluid step
 /// 1e-4 s) and ε of a bed cell. Every coupling step's momentum balance must close to 1e-12.
-pub(crate) fn fixed_bed(model: MomentumModel, u: f64) -> Result<(f64, f64), String> {
+pub(crate) fn fixed_bed(model: MomentumModel, exchange: Exchange, u: f64) -> Result<(f64, f64), String> {
     let d = 1e-3;
     let s = 1.05 * d;
     let h = 2.0 * s;
@@ -95,6 +95,7 @@ pub(crate) fn fixed_bed(model: MomentumModel, u: f64) -> Result<(f64, f64), Stri
     let opts = CouplingOptions {
         forces: FluidForceOptions { drag: DragModel::ErgunWenYu, ..Default::default() },
         model,
+        exchange,
         ..Default::default()
     };
     let mut c = Coupled::new(f, dm, opts).map_err(|e| e.to_string())?;
@@ -115,7 +116,7 @@ pub(crate) fn fixed_bed(model: MomentumModel, u: f64) -> Result<(f64, f64), Stri
 /// step 1e-4 s, DEM step 1e-5 s, drag `schiller_naumann`. Returns the bead's mean settling speed and its
 /// mean slip relative to the interstitial fluid at it over t = 0.12–0.15 s, and the Schiller–Naumann
 /// terminal speed with buoyancy \[m/s\].
-pub(crate) fn settling(model: MomentumModel) -> Result<(f64, f64, f64), String> {
+pub(crate) fn settling(model: MomentumModel, exchange: Exchange) -> Result<(f64, f64, f64), String> {
     let h = 3e-3;
     let wall = || Boundary::Wall { velocity_m_s: [0.0; 3] };
     let f = flow([10, 10, 20], h, std::array::from_fn(|_| wall()))?;
@@ -124,6 +125,7 @@ pub(crate) fn settling(model: MomentumModel) -> Result<(f64, f64, f64), String> 
     let opts = CouplingOptions {
         forces: FluidForceOptions { drag: DragModel::SchillerNaumann, ..Default::default() },
         model,
+        exchange,
         ..Default::default()
     };
     let mut c = Coupled::new(f, d, opts).map_err(|e| e.to_string())?;
@@ -169,7 +171,7 @@ fn ergun_case(quick: bool) -> Vec<Check> {
     cases
         .iter()
         .map(|&(model, u)| {
-            let grad = fixed_bed(model, u).map_or(f64::NAN, |r| r.0);
+            let grad = fixed_bed(model, Exchange::Explicit, u).map_or(f64::NAN, |r| r.0);
             let q = format!("dp/dz, model {model:?}, U = {u} m/s [Pa/m]");
             Check::relative(c, q, ergun(eps, u, 1e-3, &water()), grad, 0.01, src)
         })
@@ -185,7 +187,7 @@ fn settling_case(quick: bool) -> Vec<Check> {
     models
         .iter()
         .map(|&model| {
-            let (v, wt) = settling(model).map_or((f64::NAN, 0.14595), |r| (r.0, r.2));
+            let (v, wt) = settling(model, Exchange::Explicit).map_or((f64::NAN, 0.14595), |r| (r.0, r.2));
             Check::relative(c, format!("settling speed, model {model:?} [m/s]"), wt, v, 0.03, src)
         })
         .collect()

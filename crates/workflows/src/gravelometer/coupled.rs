@@ -166,6 +166,7 @@ pub fn coupled_fluid(cfg: &GravelometerConfig, dom: &AirDomain) -> Result<Couple
             pressure_force: true,
         },
         model: MomentumModel::A,
+        exchange: crate::cfd_dem::Exchange::Explicit,
         void_fraction: VoidFractionMethod::Divided,
         alpha_min: 0.3,
         dem_steps_per_fluid_step: dom.substeps,
