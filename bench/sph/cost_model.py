@@ -23,8 +23,10 @@ Four ways to run are compared: every wall particle in every rank's wall set (the
 now) with one rank per core and with one rank per node and a thread per core (the wall set's per-step
 rebuild runs on one thread), and the boundary also stored only where it is needed (not built: today
 every rank holds the reference positions of every wall particle). Walls are assumed spread over the
-ranks like the water. Only the standard
-library is used. Every assumption is an option; `--help` lists them.
+ranks like the water, which is optimistic: the outer boxes also hold the dry walls beyond the water,
+and the rank with the most walls sets the pace (docs/scaling.md). The scene is the `wading` example's
+run as an `sph`-kind scenario without surface tension and adhesion (which do not run on ranks yet).
+Only the standard library is used. Every assumption is an option; `--help` lists them.
 """
 
 import argparse

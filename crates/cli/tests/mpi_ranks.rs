@@ -240,6 +240,21 @@ fn two_ranks_resume_on_two_and_on_one() {
     assert_eq!(err.matches("it needs --resume").count(), 1, "{err}");
 }
 
+/// An `mpirun` started by a test: killed with its ranks when the test ends before it does (a failed
+/// assertion, a hang), so that no rank outlives the test.
+struct Job(std::process::Child);
+
+impl Drop for Job {
+    fn drop(&mut self) {
+        if matches!(self.0.try_wait(), Ok(None)) {
+            let mut pids: Vec<String> = children(self.0.id()).iter().map(u32::to_string).collect();
+            pids.push(self.0.id().to_string());
+            let _ = Command::new("sh").arg("-c").arg(format!("kill -KILL {}", pids.join(" "))).status();
+            let _ = self.0.wait();
+        }
+    }
+}
+
 /// The processes whose parent is `pid` (from `/proc`).
 fn children(pid: u32) -> Vec<u32> {
     let mut out = Vec::new();
@@ -285,7 +300,7 @@ fn sigterm_stops_every_rank_with_a_checkpoint_that_resumes_bit_for_bit() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for (name, to_ranks) in [("mpirun", false), ("ranks", true)] {
         let out = tmp.path().join(name);
-        let mut child = Command::new("mpirun")
+        let mut job = Job(Command::new("mpirun")
             .args(["--oversubscribe", "--mca", "odls_base_sigkill_timeout", "5", "-n", "2"])
             .arg(env!("CARGO_BIN_EXE_spatter"))
             .args(run(&out, &[]))
@@ -294,7 +309,8 @@ fn sigterm_stops_every_rank_with_a_checkpoint_that_resumes_bit_for_bit() {
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
-            .expect("mpirun starts");
+            .expect("mpirun starts"));
+        let child = &mut job.0;
         let started = Instant::now();
         while !out.join("log.txt").is_file() {
             assert!(started.elapsed() < Duration::from_secs(60), "{name}: the run never opened its log");
@@ -302,7 +318,7 @@ fn sigterm_stops_every_rank_with_a_checkpoint_that_resumes_bit_for_bit() {
         }
         std::thread::sleep(Duration::from_secs(1));
         let targets = if to_ranks { children(child.id()) } else { vec![child.id()] };
-        assert!(!targets.is_empty(), "{name}: the ranks run");
+        assert_eq!(targets.len(), if to_ranks { 2 } else { 1 }, "{name}: both ranks run: {targets:?}");
         // The shell's own `kill` (no procps needed).
         let list: Vec<String> = targets.iter().map(u32::to_string).collect();
         let kill =
@@ -312,10 +328,7 @@ fn sigterm_stops_every_rank_with_a_checkpoint_that_resumes_bit_for_bit() {
             if let Some(s) = child.try_wait().unwrap() {
                 break s;
             }
-            if started.elapsed() > Duration::from_secs(KILL_AFTER_S) {
-                let _ = child.kill();
-                panic!("{name}: mpirun did not end within {KILL_AFTER_S} s");
-            }
+            assert!(started.elapsed() < Duration::from_secs(KILL_AFTER_S), "{name}: mpirun did not end");
             std::thread::sleep(Duration::from_millis(100));
         };
         assert!(!status.success(), "{name}: stopped, not finished");

@@ -267,7 +267,7 @@ pub fn report(
     )
     .map_err(io_err(&path))?;
     // For a study: the shares of every case in one chart (strip number against share) and one table
-    // with a column per case (docs/studies.md, "Curves and tables across cases").
+    // with a column per case (docs/studies.md, "Curves and tables side by side").
     summary.curves.push(CurveRecord {
         label: STRIP_SHARE_CURVE.into(),
         csv: path.clone(),

@@ -1,8 +1,9 @@
 //! Bisection of the boundary between the two sides of a test along one number (a position, a time).
 
-/// Most halvings: more than the 2 × 1 075 steps between the smallest and largest doubles could never
-/// be needed for the brackets used here, but a limit keeps a non-monotone test from looping; a bracket
-/// of a few metres or seconds closes to neighbouring numbers in about 60 halvings.
+/// Most halvings. A bracket of a few metres or seconds closes to neighbouring numbers in about 60
+/// halvings, and no bracket of finite numbers needs more than about 2 100 (the binary exponents between
+/// the smallest and the largest double); 200 is ample for the brackets used here and keeps a
+/// predicate that is not monotone from looping long.
 const MAX_HALVINGS: usize = 200;
 
 /// Narrows the bracket `[out, inside]` (either order) around the point where `is_out` changes from true

@@ -171,8 +171,10 @@ impl StlChannel {
     fn find_pool(&mut self, path: &Path, depth: f64) -> Result<(), ChannelFileError> {
         let y = self.y_mid();
         let (x0, x1) = self.x_range;
-        let xs: Vec<f64> =
+        let mut xs: Vec<f64> =
             (0..=PROFILE_SAMPLES).map(|i| x0 + (x1 - x0) * i as f64 / PROFILE_SAMPLES as f64).collect();
+        // x0 + (x1 − x0) can round past x1.
+        xs[PROFILE_SAMPLES] = x1;
         let zs: Vec<Option<f64>> = xs.iter().map(|&x| self.road_z(x, y)).collect();
         self.check_gaps(path, &xs, &zs)?;
         let wet = |z: Option<f64>| z.is_some_and(|z| z < self.water_z);
@@ -232,7 +234,13 @@ impl StlChannel {
     /// extent) is such a stretch too. Gaps narrower than the sampling (1/4000 of the road's length) are
     /// not seen.
     fn check_gaps(&self, path: &Path, xs: &[f64], zs: &[Option<f64>]) -> Result<(), ChannelFileError> {
-        let Some(k) = zs.iter().position(Option::is_none) else {
+        // The end samples lie exactly on the road's end edges, where a ray may miss the triangles by
+        // rounding: a single missing sample at an end is no gap (narrower than one sample, like any gap
+        // this check cannot see).
+        let n = zs.len();
+        let edge_miss =
+            |k: usize| (k == 0 && n > 1 && zs[1].is_some()) || (k + 1 == n && n > 1 && zs[n - 2].is_some());
+        let Some(k) = (0..n).position(|k| zs[k].is_none() && !edge_miss(k)) else {
             return Ok(());
         };
         let y = self.y_mid();
@@ -431,6 +439,26 @@ pub(crate) mod tests {
             "{}",
             e.message
         );
+    }
+
+    /// A ray that misses the road exactly at one of its end edges (rounding) is no gap; two missing
+    /// samples at an end, or one inside, are.
+    #[test]
+    fn a_single_missing_end_sample_is_no_gap() {
+        let dir = tempfile::tempdir().unwrap();
+        let ramp: &[(f64, f64)] = &[(0.0, 0.5), (2.0, 0.0), (8.0, 0.0), (10.0, 0.5)];
+        let f = strip_channel(dir.path(), &road_strips(&[ramp]));
+        let s = StlChannel::read(&f, 0.3).unwrap();
+        let xs: Vec<f64> = (0..=10).map(f64::from).collect();
+        let road = |missing: &[usize]| -> Vec<Option<f64>> {
+            (0..=10).map(|k| (!missing.contains(&k)).then_some(0.0)).collect()
+        };
+        for ok in [&[][..], &[0], &[10], &[0, 10]] {
+            assert!(s.check_gaps(&f, &xs, &road(ok)).is_ok(), "{ok:?}");
+        }
+        for gap in [&[0, 1][..], &[9, 10], &[5]] {
+            assert!(s.check_gaps(&f, &xs, &road(gap)).is_err(), "{gap:?}");
+        }
     }
 
     #[test]
