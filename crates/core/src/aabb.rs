@@ -60,4 +60,17 @@ impl Aabb {
             e.x * e.y * e.z
         }
     }
+
+    /// Euclidean distance to the box `o` (0 when they touch or overlap) \[m\]. An infinite face (the
+    /// outer boxes of a domain split over ranks) never adds: its gap of −∞ is clamped to 0.
+    pub fn gap(&self, o: &Aabb) -> f64 {
+        let mut d2 = 0.0;
+        for axis in 0..3 {
+            let gap = (self.min[axis] - o.max[axis]).max(o.min[axis] - self.max[axis]).max(0.0);
+            if gap.is_finite() {
+                d2 += gap * gap;
+            }
+        }
+        d2.sqrt()
+    }
 }

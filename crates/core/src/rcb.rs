@@ -202,7 +202,7 @@ impl Rcb {
                         if rank == me && shift == Vec3::ZERO {
                             continue;
                         }
-                        if box_gap(&mine, &Aabb::new(other.min + shift, other.max + shift)) <= width {
+                        if mine.gap(&Aabb::new(other.min + shift, other.max + shift)) <= width {
                             out.push(Peer { rank, shift });
                         }
                     }
@@ -211,19 +211,6 @@ impl Rcb {
         }
         out
     }
-}
-
-/// Euclidean distance between two boxes (0 when they touch or overlap) \[m\].
-fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
-    let mut d2 = 0.0;
-    for axis in 0..3 {
-        let gap = (a.min[axis] - b.max[axis]).max(b.min[axis] - a.max[axis]).max(0.0);
-        // An infinite face gives a gap of −∞, clamped to 0 above; only finite gaps add up.
-        if gap.is_finite() {
-            d2 += gap * gap;
-        }
-    }
-    d2.sqrt()
 }
 
 #[cfg(test)]
@@ -318,7 +305,7 @@ mod tests {
         let boxes = four.boxes();
         for me in 0..4 {
             for p in four.peers(me, 0.5) {
-                assert!(box_gap(&boxes[me], &boxes[p.rank]) <= 0.5);
+                assert!(boxes[me].gap(&boxes[p.rank]) <= 0.5);
             }
         }
     }

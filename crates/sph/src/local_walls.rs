@@ -42,20 +42,7 @@ pub(crate) struct LocalWalls {
 
 /// Euclidean distance from `x` to the box `b` (0 inside; infinite faces never add) \[m\].
 pub(crate) fn point_gap(x: Vec3, b: &Aabb) -> f64 {
-    box_gap(x, x, b)
-}
-
-/// Euclidean distance between the box `lo..hi` and the box `b` (0 when they overlap; infinite faces of
-/// `b` never add) \[m\].
-fn box_gap(lo: Vec3, hi: Vec3, b: &Aabb) -> f64 {
-    let mut d2 = 0.0;
-    for a in 0..3 {
-        let g = (b.min[a] - hi[a]).max(lo[a] - b.max[a]).max(0.0);
-        if g.is_finite() {
-            d2 += g * g;
-        }
-    }
-    d2.sqrt()
+    Aabb::new(x, x).gap(b)
 }
 
 impl LocalWalls {
@@ -97,7 +84,7 @@ impl LocalWalls {
             let f = &b.frames[c.part as usize];
             let centre = f.to_world(c.centre);
             let half = f.rot.abs() * c.half;
-            *near = box_gap(centre - half, centre + half, region) <= reach;
+            *near = Aabb::new(centre - half, centre + half).gap(region) <= reach;
         });
         for (c, _) in self.chunks.iter().zip(&self.near).filter(|(_, &near)| near) {
             for i in c.start as usize..c.end as usize {

@@ -149,17 +149,20 @@ pub fn wheel_through_water(w: &WheelRun, every: f64) -> Vec<WheelSample> {
     out
 }
 
+/// Half the chord a horizontal line at height `z` \[m\] above the floor cuts from a wheel of radius `r`
+/// standing on it: how far the mantle reaches along the floor at that height \[m\] (z clamped to [0, r]).
+fn half_chord(r: f64, z: f64) -> f64 {
+    let z = z.clamp(0.0, r);
+    (r * r - (r - z) * (r - z)).sqrt()
+}
+
 /// Upward hydrostatic force \[N\] on the lower half-mantle (one side of the axle) of a cylinder of radius
 /// `r` and width `b` standing on the floor under water up to `level` \[m\] on that side: ρ g b times the
 /// area between the water surface and the mantle over the horizontal distances s from the contact line
 /// where the mantle is below the surface and at least `gap` above the floor (s from
 /// √(r² − (r − gap)²) to √(r² − (r − level)²); midpoint rule, 4 000 intervals).
 pub fn mantle_lift(r: f64, b: f64, level: f64, gap: f64) -> f64 {
-    let reach = |z: f64| {
-        let z = z.clamp(0.0, r);
-        (r * r - (r - z) * (r - z)).sqrt()
-    };
-    let (s0, s1) = (reach(gap), reach(level));
+    let (s0, s1) = (half_chord(r, gap), half_chord(r, level));
     if s1 <= s0 {
         return 0.0;
     }
@@ -227,9 +230,8 @@ pub fn wheel_wading(quick: bool) -> Vec<Check> {
     let (hf, hr) = (h + all.front, h + all.rear);
     let fx = -0.5 * RHO * G * bw * (hf * hf - hr * hr);
     let fz = mantle_lift(r, bw, hf, dp) + mantle_lift(r, bw, hr, dp);
-    let reach = |z: f64| (r * r - (r - z.min(r)).powi(2)).sqrt();
     let tol_fx = RHO * G * bw * (hf + hr) * 0.5 * dp;
-    let tol_fz = RHO * G * bw * (reach(hf) + reach(hr) - 2.0 * reach(dp)) * 0.5 * dp;
+    let tol_fz = RHO * G * bw * (half_chord(r, hf) + half_chord(r, hr) - 2.0 * half_chord(r, dp)) * 0.5 * dp;
     let du = w.speed - all.ahead_u;
     let label = format!(
         "(mean 0.5–1 s: η_f = {:.4} m over the still level against U²/2g = {:.4} m; η_a = {:.4} m, u_a = {:.3} m/s)",
@@ -239,7 +241,7 @@ pub fn wheel_wading(quick: bool) -> Vec<Check> {
         all.ahead_u
     );
     let steady = |x: f64, y: f64| (x - y).abs() / (0.5 * (x + y)).abs();
-    vec![
+    let mut checks = vec![
         Check::absolute(
             case,
             format!("run-up over the level ahead η_f − η_a [m] {label}"),
@@ -264,29 +266,18 @@ pub fn wheel_wading(quick: bool) -> Vec<Check> {
             tol_fz,
             "hydrostatic load of the measured levels on the lower mantle, wedge below dp dry",
         ),
-        Check::absolute(
+    ];
+    for (name, x, y, tol) in [("F_x", a.force.x, b.force.x, 0.10), ("F_z", a.force.z, b.force.z, 0.05)] {
+        checks.push(Check::absolute(
             case,
-            format!(
-                "F_x steady: |mean 0.5–0.75 s − mean 0.75–1 s| / mean [-] ({:.2} / {:.2} N)",
-                a.force.x, b.force.x
-            ),
+            format!("{name} steady: |mean 0.5–0.75 s − mean 0.75–1 s| / mean [-] ({x:.2} / {y:.2} N)"),
             0.0,
-            steady(a.force.x, b.force.x),
-            0.10,
+            steady(x, y),
+            tol,
             "a steady state",
-        ),
-        Check::absolute(
-            case,
-            format!(
-                "F_z steady: |mean 0.5–0.75 s − mean 0.75–1 s| / mean [-] ({:.2} / {:.2} N)",
-                a.force.z, b.force.z
-            ),
-            0.0,
-            steady(a.force.z, b.force.z),
-            0.05,
-            "a steady state",
-        ),
-    ]
+        ));
+    }
+    checks
 }
 
 #[cfg(test)]

@@ -143,16 +143,7 @@ fn each_rank_holds_the_walls_near_its_box() {
         }
         let support = sim.kernel().support();
         let region = sim.rank_box().unwrap();
-        let gap = |x: Vec3| {
-            let mut d2 = 0.0;
-            for a in 0..3 {
-                let g = (region.min[a] - x[a]).max(x[a] - region.max[a]).max(0.0);
-                if g.is_finite() {
-                    d2 += g * g;
-                }
-            }
-            d2.sqrt()
-        };
+        let gap = |x: Vec3| Aabb::new(x, x).gap(&region);
         let near = (0..sim.boundary.len()).filter(|&i| gap(sim.boundary.position(i)) <= support).count();
         (sim.wall_entries(), near, sim.boundary.len())
     });

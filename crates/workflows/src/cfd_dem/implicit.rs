@@ -24,7 +24,7 @@
 //! kicks with it rather than with the previous step's (which would hand the spheres
 //! Δt_DEM/2 (F_old − F_new) more than they take from the fluid, and overshoot in stiff cells).
 
-use super::exchange::{pressure_gradient_nodes, GridFluid};
+use super::exchange::GridFluid;
 use super::{Coupling, ExchangeReport, MomentumModel};
 use crate::fluid_forces::FluidSampler;
 use rayon::prelude::*;
@@ -76,15 +76,10 @@ impl Coupling {
     /// Void fraction, the linearised exchange of every sphere of `dem` over a fluid step `dt`, and the
     /// fluid's implicit source from it.
     pub(super) fn prepare_implicit<L: ContactLaw>(&mut self, dem: &Simulation<L>, dt: f64) {
-        let t0 = Instant::now();
+        let t1 = self.sample_fields(&dem.particles.pos, &dem.particles.radius);
         let p = &dem.particles;
-        self.void_fraction.update(&self.flow.grid, &self.flow.blocked, &p.pos, &p.radius);
-        let t1 = Instant::now();
-        pressure_gradient_nodes(&self.flow, &mut self.grad_p);
         let n = p.len();
         self.linear.resize(n, Linear::default());
-        self.inside.resize(n, false);
-        self.shares.resize(n, None);
         let sampler =
             GridFluid { flow: &self.flow, void_fraction: &self.void_fraction, grad_p: &self.grad_p };
         let opts = &self.options;
@@ -148,7 +143,6 @@ impl Coupling {
                 src.s[comp][c] += a * (lin.beta * v_eff[comp] - rest[comp]);
             }
         }
-        self.times.void_fraction += (t1 - t0).as_secs_f64();
         self.times.forces += t1.elapsed().as_secs_f64();
     }
 

@@ -291,16 +291,11 @@ impl Coupling {
     /// the momentum balance. This is the explicit exchange; with `exchange = semi_implicit` a coupling
     /// step recomputes every force around its fluid step, so this serves for outputs only.
     pub fn exchange<L: ContactLaw>(&mut self, dem: &mut Simulation<L>) -> ExchangeReport {
-        let t0 = Instant::now();
+        let t1 = self.sample_fields(&dem.particles.pos, &dem.particles.radius);
         let p = &dem.particles;
-        self.void_fraction.update(&self.flow.grid, &self.flow.blocked, &p.pos, &p.radius);
-        let t1 = Instant::now();
-        pressure_gradient_nodes(&self.flow, &mut self.grad_p);
         let n = p.len();
         self.exchanged.resize(n, Vec3::ZERO);
         self.on_particles.resize(n, Vec3::ZERO);
-        self.inside.resize(n, false);
-        self.shares.resize(n, None);
         let sampler =
             GridFluid { flow: &self.flow, void_fraction: &self.void_fraction, grad_p: &self.grad_p };
         let opts = &self.options;
@@ -376,10 +371,22 @@ impl Coupling {
             outside,
             alpha_min,
         };
-        let t3 = Instant::now();
-        self.times.void_fraction += (t1 - t0).as_secs_f64();
-        self.times.forces += (t3 - t1).as_secs_f64();
+        self.times.forces += t1.elapsed().as_secs_f64();
         self.last
+    }
+
+    /// The start of both exchanges: the void fraction of the spheres at `pos` with radii `radius` (its
+    /// time added to `times.void_fraction`), the pressure gradient at the velocity nodes, and the
+    /// per-sphere buffers sized for them. Returns when the forces' clock starts.
+    fn sample_fields(&mut self, pos: &[Vec3], radius: &[f64]) -> Instant {
+        let t0 = Instant::now();
+        self.void_fraction.update(&self.flow.grid, &self.flow.blocked, pos, radius);
+        let t1 = Instant::now();
+        self.times.void_fraction += (t1 - t0).as_secs_f64();
+        pressure_gradient_nodes(&self.flow, &mut self.grad_p);
+        self.inside.resize(pos.len(), false);
+        self.shares.resize(pos.len(), None);
+        t1
     }
 
     /// The fluid part of a coupling step spanning `substeps` DEM steps: exchange with `dem`, then one
