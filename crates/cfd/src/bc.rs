@@ -1,5 +1,8 @@
 //! Boundary conditions on the six sides of the box: no-slip (possibly moving) and free-slip walls,
 //! symmetry planes and the axis, velocity inlets with a time table, and fixed-pressure outlets.
+//!
+//! Pressures in this module are in pascals, as the user gives them; the solver divides them by the
+//! density (it works in kinematic pressure p/ρ, m²/s²).
 
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
@@ -90,7 +93,7 @@ pub enum Boundary {
         #[serde(default)]
         table: TimeTable,
     },
-    /// Outlet at fixed static pressure `pressure_pa`; zero normal gradient of the velocity.
+    /// Outlet at fixed static pressure `pressure_pa` \[Pa\]; zero normal gradient of the velocity.
     Outlet {
         #[serde(default)]
         pressure_pa: f64,
@@ -116,8 +119,20 @@ impl Boundary {
         }
     }
 
-    pub fn is_outlet(&self) -> bool {
+    /// Whether the side holds the pressure (an outlet): its normal velocity is
+    /// found by the pressure correction, and it fixes the pressure level of the fluid it touches.
+    pub fn holds_pressure(&self) -> bool {
         matches!(self, Boundary::Outlet { .. })
+    }
+
+    /// Static pressure the side holds at time `t` \[Pa\] on a face whose inward normal velocity is
+    /// `u_in` \[m/s\] (positive into the domain), for fluid of density `rho` \[kg/m³\]; `None` for sides
+    /// that do not hold the pressure.
+    pub fn static_pressure(&self, _t: f64, _u_in: f64, _rho: f64) -> Option<f64> {
+        match self {
+            Boundary::Outlet { pressure_pa } => Some(*pressure_pa),
+            _ => None,
+        }
     }
 }
 

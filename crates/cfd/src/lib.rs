@@ -38,6 +38,9 @@ pub mod turbulence;
 pub mod validation;
 pub mod wall_shear;
 
+#[cfg(test)]
+mod pressure_sides_tests;
+
 pub use bc::{Boundary, TimeTable};
 pub use grid::{Axis, Grid, Mode};
 pub use solid::Solid;

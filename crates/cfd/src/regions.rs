@@ -27,7 +27,7 @@ pub struct Region {
     /// Bounding box of the cells \[m\].
     pub lo: [f64; 3],
     pub hi: [f64; 3],
-    /// Sides with an outlet face on this region.
+    /// Sides that hold the pressure (outlets) with a face on this region.
     pub outlets: Vec<usize>,
     /// Sides with an inlet face on this region, with the inlet's face area on it \[m²\] (per radian when
     /// axisymmetric).
@@ -100,7 +100,7 @@ pub fn find(grid: &Grid, bc: &[Boundary; 6], blocked: &[bool]) -> Regions {
                     if at_side {
                         let side = 2 * a + usize::from(plus);
                         match &bc[side] {
-                            Boundary::Outlet { .. } if !reg.outlets.contains(&side) => reg.outlets.push(side),
+                            b if b.holds_pressure() && !reg.outlets.contains(&side) => reg.outlets.push(side),
                             Boundary::Inlet { .. } => {
                                 let mut qf = q;
                                 if !plus {
