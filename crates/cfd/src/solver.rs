@@ -14,11 +14,12 @@
 //! 3. pressure correction φ from ∇·(∇φ) = ∇·u*/Δt, solved by multigrid-preconditioned CG;
 //! 4. uⁿ⁺¹ = u* − Δt ∇φ (discretely divergence-free to the solver tolerance), pⁿ⁺¹ = pⁿ + φ.
 //!
-//! Sides that hold the pressure (outlets) are Dirichlet faces of the pressure:
+//! Sides that hold the pressure (outlets, total-pressure sides) are Dirichlet faces of the pressure:
 //! the normal velocity on such a face is copied from the interior node in the predictor (zero normal
 //! gradient) and then corrected by Δt times the gradient of φ across the half cell between the cell
 //! centre and the face. Each face remembers the kinematic pressure p_b it holds ([`State::p_faces`]);
-//! a step computes the new face value p_b⁺ from the side's condition at tⁿ⁺¹ and solves for φ with the face
+//! a step computes the new face value p_b⁺ from the side's condition at tⁿ⁺¹ — for a total-pressure side
+//! from the face velocity uⁿ at the start of the step (explicit in time) — and solves for φ with the face
 //! value φ_b = p_b⁺ − p_b, so that pⁿ⁺¹ holds p_b⁺ on the face. A side whose pressure does not change
 //! has φ_b = 0, the homogeneous condition.
 
@@ -259,7 +260,7 @@ impl Flow {
         let face_ops = [0, 1, 2].map(|a| DirOps::face(&grid.metric[a]));
         let zeros = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         // The fluid starts at rest at the static pressure of the first side that holds the pressure (in
-        // side order), so that a single outlet pressure shifts the
+        // side order; a total-pressure side's p₀ at t = 0), so that a single outlet pressure shifts the
         // pressure field and changes nothing else.
         let level =
             bc.iter().find_map(|b| b.static_pressure(0.0, 0.0, fluid.density)).unwrap_or(0.0) / fluid.density;
@@ -394,7 +395,7 @@ impl Flow {
                                     (idx(g - 1), idx(g - 2), idx(g), None)
                                 };
                                 match bc {
-                                    Boundary::Outlet { .. } => {}
+                                    Boundary::Outlet { .. } | Boundary::TotalPressure { .. } => {}
                                     Boundary::Inlet { .. } => u[bnode] = vel.map_or(0.0, |v| v[a]),
                                     _ => u[bnode] = 0.0,
                                 }
@@ -415,7 +416,9 @@ impl Flow {
                                             2.0 * vel.map_or(0.0, |v| v[a]) - u[mi]
                                         }
                                         Boundary::Slip | Boundary::Axis => u[mi],
-                                        Boundary::Outlet { .. } => u[idx(if plus { g + n - 1 } else { g })],
+                                        Boundary::Outlet { .. } | Boundary::TotalPressure { .. } => {
+                                            u[idx(if plus { g + n - 1 } else { g })]
+                                        }
                                     };
                                 }
                             }
@@ -748,7 +751,10 @@ impl Flow {
     }
 
     /// The largest stable time step: `courant`·min(Δx/|u|) and 0.9 of the explicit diffusion limit
-    /// Δt ≤ 1/(4ν Σ 1/Δx²) of second-order Adams–Bashforth; capped at `dt_max`.
+    /// Δt ≤ 1/(4ν Σ 1/Δx²) of second-order Adams–Bashforth; capped at `dt_max`. Where sides that hold the
+    /// pressure differ in pressure, |u| is taken at least as the Bernoulli speed of the largest difference,
+    /// √(2Δp/ρ) (see [`Flow::pressure_speed`]), over the smallest cell width: fluid at rest between them is
+    /// about to move that fast.
     pub fn stable_dt(&self, courant: f64, dt_max: f64) -> f64 {
         let l = self.grid.layout;
         let m = &self.grid.metric;
@@ -775,8 +781,30 @@ impl Flow {
             });
             diff = diff.min(0.9 / (4.0 * nu_rate));
         }
+        let u_p = self.pressure_speed(self.state.t);
+        let rate = if u_p > 0.0 {
+            let h = (0..dims).map(|a| self.grid.axes[a].min_width()).fold(f64::INFINITY, f64::min);
+            rate.max(u_p / h)
+        } else {
+            rate
+        };
         let conv = if rate > 0.0 { courant / rate } else { f64::INFINITY };
         dt_max.min(diff).min(conv)
+    }
+
+    /// The Bernoulli speed √(2Δp/ρ) \[m/s\] of the largest difference Δp between the pressures the sides
+    /// that hold the pressure have at time `t` for fluid at rest (outlets their static pressure,
+    /// total-pressure sides p₀): the fastest that difference drives the fluid without losses. 0 when
+    /// there are fewer than two such sides or they agree.
+    pub fn pressure_speed(&self, t: f64) -> f64 {
+        let rho = self.fluid.density;
+        let held: Vec<f64> = self.bc.iter().filter_map(|b| b.static_pressure(t, 0.0, rho)).collect();
+        let hi = held.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let lo = held.iter().copied().fold(f64::INFINITY, f64::min);
+        if held.len() < 2 || hi <= lo {
+            return 0.0;
+        }
+        (2.0 * (hi - lo) / rho).sqrt()
     }
 
     /// Velocity at the centre of interior cell (i, j, k) (average of the two face values per component).
