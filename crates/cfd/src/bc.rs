@@ -1,5 +1,9 @@
 //! Boundary conditions on the six sides of the box: no-slip (possibly moving) and free-slip walls,
-//! symmetry planes and the axis, velocity inlets with a time table, and fixed-pressure outlets.
+//! symmetry planes and the axis, velocity inlets with a time table, fixed-pressure outlets and
+//! total-pressure sides.
+//!
+//! Pressures in this module are in pascals, as the user gives them; the solver divides them by the
+//! density (it works in kinematic pressure p/ρ, m²/s²).
 
 use serde::{Deserialize, Serialize};
 use spatter_core::check::{Checker, Validate};
@@ -90,10 +94,19 @@ pub enum Boundary {
         #[serde(default)]
         table: TimeTable,
     },
-    /// Outlet at fixed static pressure `pressure_pa`; zero normal gradient of the velocity.
+    /// Outlet at fixed static pressure `pressure_pa` \[Pa\]; zero normal gradient of the velocity.
     Outlet {
         #[serde(default)]
         pressure_pa: f64,
+    },
+    /// Total-pressure side (OpenFOAM's `totalPressure`): where the fluid enters, the static pressure on
+    /// the face is p = p₀ − ½ρu_n² with p₀ = `total_pressure_pa` × `table(t)` \[Pa\] and u_n the face's
+    /// normal velocity; where it leaves, p = p₀. The velocity has zero normal gradient both ways, as at
+    /// an outlet (fluid enters in the direction it has next to the side).
+    TotalPressure {
+        total_pressure_pa: f64,
+        #[serde(default)]
+        table: TimeTable,
     },
 }
 
@@ -116,8 +129,24 @@ impl Boundary {
         }
     }
 
-    pub fn is_outlet(&self) -> bool {
-        matches!(self, Boundary::Outlet { .. })
+    /// Whether the side holds the pressure (an outlet or a total-pressure side): its normal velocity is
+    /// found by the pressure correction, and it fixes the pressure level of the fluid it touches.
+    pub fn holds_pressure(&self) -> bool {
+        matches!(self, Boundary::Outlet { .. } | Boundary::TotalPressure { .. })
+    }
+
+    /// Static pressure the side holds at time `t` \[Pa\] on a face whose inward normal velocity is
+    /// `u_in` \[m/s\] (positive into the domain), for fluid of density `rho` \[kg/m³\]; `None` for sides
+    /// that do not hold the pressure.
+    pub fn static_pressure(&self, t: f64, u_in: f64, rho: f64) -> Option<f64> {
+        match self {
+            Boundary::Outlet { pressure_pa } => Some(*pressure_pa),
+            Boundary::TotalPressure { total_pressure_pa, table } => {
+                let p0 = total_pressure_pa * table.at(t);
+                Some(if u_in > 0.0 { p0 - 0.5 * rho * u_in * u_in } else { p0 })
+            }
+            _ => None,
+        }
     }
 }
 
@@ -130,6 +159,10 @@ impl Validate for Boundary {
                 c.item("table", table);
             }
             Boundary::Outlet { pressure_pa } => c.finite("pressure_pa", *pressure_pa),
+            Boundary::TotalPressure { total_pressure_pa, table } => {
+                c.finite("total_pressure_pa", *total_pressure_pa);
+                c.item("table", table);
+            }
             Boundary::Slip | Boundary::Axis => {}
         }
     }
@@ -151,5 +184,31 @@ mod tests {
         let errs = Checker::run(&bad, None).unwrap_err();
         assert_eq!(errs.len(), 2, "{errs:?}");
         assert!(errs.iter().any(|e| e.message.contains("increase strictly")));
+    }
+
+    #[test]
+    fn total_pressure_holds_p0_minus_the_dynamic_pressure_of_inflow_and_p0_on_outflow() {
+        let table = TimeTable { t_s: vec![0.0, 2.0], factor: vec![0.0, 1.0] };
+        let b = Boundary::TotalPressure { total_pressure_pa: 100.0, table };
+        // Inflow at 2 m/s into air of 1.2 kg/m³ at t = 1 s: p₀ = 50 Pa, ½ρu² = 2.4 Pa.
+        assert_eq!(b.static_pressure(1.0, 2.0, 1.2), Some(50.0 - 2.4));
+        // Outflow: the static pressure is p₀.
+        assert_eq!(b.static_pressure(1.0, -2.0, 1.2), Some(50.0));
+        assert_eq!(b.static_pressure(5.0, 0.0, 1.2), Some(100.0));
+        assert!(b.holds_pressure() && !Boundary::Slip.holds_pressure());
+        assert_eq!(Boundary::Outlet { pressure_pa: 7.0 }.static_pressure(3.0, 1.0, 1.2), Some(7.0));
+        assert_eq!(Boundary::Slip.static_pressure(0.0, 0.0, 1.0), None);
+        // A non-finite total pressure or a bad table is refused with the key named.
+        let bad = Boundary::TotalPressure {
+            total_pressure_pa: f64::NAN,
+            table: TimeTable { t_s: vec![1.0, 0.0], factor: vec![1.0, 1.0] },
+        };
+        let errs = Checker::run(&bad, None).unwrap_err();
+        assert_eq!(errs.len(), 2, "{errs:?}");
+        assert!(errs.iter().any(|e| e.key.contains("total_pressure_pa")), "{errs:?}");
+        assert!(
+            errs.iter().any(|e| e.key.contains("t_s") && e.message.contains("increase strictly")),
+            "{errs:?}"
+        );
     }
 }

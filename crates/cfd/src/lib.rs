@@ -4,7 +4,8 @@
 //!   3D Cartesian and 2D axisymmetric (r, z) modes;
 //! * [`solid`] — blocked cells from analytic shapes (box, plate, cylinder, pipe wall) and closed STL/OBJ;
 //! * [`regions`] — connected fluid regions and the mass balance each must satisfy;
-//! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets;
+//! * [`bc`] — walls (moving, slip), symmetry and axis, velocity inlets with time tables, pressure outlets,
+//!   total-pressure sides;
 //! * [`momentum`] — TVD (van Leer) convection and viscous diffusion on the staggered control volumes;
 //! * [`sources`] — momentum sources: actuator disks and point forces from particles;
 //! * [`turbulence`] — the standard and realizable k–ε models with wall functions;
@@ -37,6 +38,9 @@ pub mod sources;
 pub mod turbulence;
 pub mod validation;
 pub mod wall_shear;
+
+#[cfg(test)]
+mod pressure_sides_tests;
 
 pub use bc::{Boundary, TimeTable};
 pub use grid::{Axis, Grid, Mode};

@@ -1,7 +1,7 @@
 //! Connected fluid regions and the mass balance they must satisfy.
 //!
 //! Incompressible fluid cannot accumulate: a region of connected fluid cells that touches no pressure
-//! outlet must receive exactly as much volume through its inlets as it loses through them, at every time,
+//! pressure side (outlet or total-pressure side) must receive exactly as much volume through its inlets as it loses through them, at every time,
 //! and its pressure is defined only up to a constant. The pressure solver handles one such closed region
 //! (a lid-driven cavity) by working on zero-mean fields. Anything else is a set-up error, refused before
 //! the first step instead of being hidden by removing the mean of the pressure equation's right-hand side:
@@ -27,7 +27,7 @@ pub struct Region {
     /// Bounding box of the cells \[m\].
     pub lo: [f64; 3],
     pub hi: [f64; 3],
-    /// Sides with an outlet face on this region.
+    /// Sides that hold the pressure (outlets, total-pressure sides) with a face on this region.
     pub outlets: Vec<usize>,
     /// Sides with an inlet face on this region, with the inlet's face area on it \[m²\] (per radian when
     /// axisymmetric).
@@ -100,7 +100,7 @@ pub fn find(grid: &Grid, bc: &[Boundary; 6], blocked: &[bool]) -> Regions {
                     if at_side {
                         let side = 2 * a + usize::from(plus);
                         match &bc[side] {
-                            Boundary::Outlet { .. } if !reg.outlets.contains(&side) => reg.outlets.push(side),
+                            b if b.holds_pressure() && !reg.outlets.contains(&side) => reg.outlets.push(side),
                             Boundary::Inlet { .. } => {
                                 let mut qf = q;
                                 if !plus {
@@ -173,8 +173,8 @@ pub fn check_mass_balance(grid: &Grid, bc: &[Boundary; 6], regions: &Regions) ->
                 let unit = if grid.mode == Mode::Axisymmetric { " per radian" } else { "" };
                 return Err(format!(
                     "inlet {} feeds {} at a net {:.4e} m³/s{unit} at t = {t} s, but {why}: incompressible fluid \
-                     cannot enter a closed region. Make one side an outlet (type = \"outlet\") reachable from \
-                     the inlet, or balance the inflow",
+                     cannot enter a closed region. Make one side an outlet (type = \"outlet\" or \
+                     \"total_pressure\") reachable from the inlet, or balance the inflow",
                     names.join(" + "),
                     reg.describe(r),
                     net
@@ -259,6 +259,10 @@ mod tests {
         assert!(e.contains("t = 0.5 s"), "{e}");
         // A closed cavity with a moving lid.
         let bc = [wall(), wall(), wall(), Boundary::Wall { velocity_m_s: [1.0, 0.0, 0.0] }, wall(), wall()];
+        check_mass_balance(&g, &bc, &find(&g, &bc, &open)).unwrap();
+        // A total-pressure side takes up the inflow like an outlet.
+        let tp = Boundary::TotalPressure { total_pressure_pa: 0.0, table: TimeTable::default() };
+        let bc = [inlet(1.0), tp, wall(), wall(), wall(), wall()];
         check_mass_balance(&g, &bc, &find(&g, &bc, &open)).unwrap();
         // The solver refuses to start on an unbalanced set-up.
         let bc = [inlet(1.0), wall(), wall(), wall(), wall(), wall()];

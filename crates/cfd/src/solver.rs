@@ -13,6 +13,15 @@
 //!    taken backward-Euler: u* ← (u* + Δt s)/(1 + Δt k);
 //! 3. pressure correction φ from ∇·(∇φ) = ∇·u*/Δt, solved by multigrid-preconditioned CG;
 //! 4. uⁿ⁺¹ = u* − Δt ∇φ (discretely divergence-free to the solver tolerance), pⁿ⁺¹ = pⁿ + φ.
+//!
+//! Sides that hold the pressure (outlets, total-pressure sides) are Dirichlet faces of the pressure:
+//! the normal velocity on such a face is copied from the interior node in the predictor (zero normal
+//! gradient) and then corrected by Δt times the gradient of φ across the half cell between the cell
+//! centre and the face. Each face remembers the kinematic pressure p_b it holds ([`State::p_faces`]);
+//! a step computes the new face value p_b⁺ from the side's condition at tⁿ⁺¹ — for a total-pressure side
+//! from the face velocity uⁿ at the start of the step (explicit in time) — and solves for φ with the face
+//! value φ_b = p_b⁺ − p_b, so that pⁿ⁺¹ holds p_b⁺ on the face. A side whose pressure does not change
+//! has φ_b = 0, the homogeneous condition.
 
 use crate::bc::{Boundary, SIDES};
 use crate::grid::{Grid, Mode, GHOST};
@@ -61,6 +70,9 @@ pub struct State {
     pub u: [Vec<f64>; 3],
     /// Kinematic pressure p/ρ at cell centres \[m²/s²\].
     pub p: Vec<f64>,
+    /// Kinematic pressure held on each face of the sides that hold the pressure \[m²/s²\], in the order
+    /// of the solver's list of those faces (x faces, then y, then z).
+    pub p_faces: Vec<f64>,
     /// Explicit terms of the previous step, for Adams–Bashforth.
     h_old: [Vec<f64>; 3],
     dt_old: f64,
@@ -123,8 +135,9 @@ pub struct Flow {
     kind: [Vec<u8>; 3],
     /// Nodes set from neighbours after every update: (node, fluid neighbours to mirror).
     solid_nodes: [Vec<(usize, Vec<usize>)>; 3],
-    /// Outlet normal nodes and the interior node they copy in the predictor.
-    outlet_nodes: [Vec<(usize, usize)>; 3],
+    /// Normal velocity nodes on the faces of the sides that hold the pressure: the node, the interior
+    /// node it copies in the predictor and the side.
+    outlet_nodes: [Vec<(usize, usize, u8)>; 3],
     centre_ops: [DirOps; 3],
     face_ops: [DirOps; 3],
     pcg: Pcg,
@@ -175,7 +188,7 @@ impl Flow {
         let n = l.len();
         let fluid_cell = |q: [usize; 3]| l.interior(q) && !blocked[l.at(q[0], q[1], q[2])];
         let mut kind = [vec![FIXED; n], vec![FIXED; n], vec![FIXED; n]];
-        let mut outlet_nodes: [Vec<(usize, usize)>; 3] = Default::default();
+        let mut outlet_nodes: [Vec<(usize, usize, u8)>; 3] = Default::default();
         for c in 0..n {
             let q = l.coords(c);
             for a in 0..3 {
@@ -195,12 +208,12 @@ impl Flow {
                 let (fa, fb) = (fluid_cell(q), fluid_cell(qn));
                 if fa && fb {
                     kind[a][c] = ACTIVE;
-                } else if q[a] == GHOST - 1 && fb && bc[2 * a].is_outlet() {
+                } else if q[a] == GHOST - 1 && fb && bc[2 * a].holds_pressure() {
                     kind[a][c] = OUTLET;
-                    outlet_nodes[a].push((c, c + l.s[a]));
-                } else if q[a] == GHOST + l.n[a] - 1 && fa && bc[2 * a + 1].is_outlet() {
+                    outlet_nodes[a].push((c, c + l.s[a], 2 * a as u8));
+                } else if q[a] == GHOST + l.n[a] - 1 && fa && bc[2 * a + 1].holds_pressure() {
                     kind[a][c] = OUTLET;
-                    outlet_nodes[a].push((c, c - l.s[a]));
+                    outlet_nodes[a].push((c, c - l.s[a], 2 * a as u8 + 1));
                 }
             }
         }
@@ -246,11 +259,18 @@ impl Flow {
         let centre_ops = [0, 1, 2].map(|a| DirOps::centre(&grid.metric[a]));
         let face_ops = [0, 1, 2].map(|a| DirOps::face(&grid.metric[a]));
         let zeros = || [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        // The fluid starts at rest at the static pressure of the first side that holds the pressure (in
+        // side order; a total-pressure side's p₀ at t = 0), so that a single outlet pressure shifts the
+        // pressure field and changes nothing else.
+        let level =
+            bc.iter().find_map(|b| b.static_pressure(0.0, 0.0, fluid.density)).unwrap_or(0.0) / fluid.density;
+        let faces = outlet_nodes.iter().map(Vec::len).sum();
         let state = State {
             t: 0.0,
             step: 0,
             u: zeros(),
-            p: vec![0.0; n],
+            p: vec![level; n],
+            p_faces: vec![level; faces],
             h_old: zeros(),
             dt_old: 0.0,
             turbulence: None,
@@ -299,7 +319,8 @@ impl Flow {
     pub fn heap_bytes(&self) -> u64 {
         let f64s = |v: &[Vec<f64>; 3]| v.iter().map(Vec::capacity).sum::<usize>();
         let st = &self.state;
-        let mut n = f64s(&st.u) + st.p.capacity() + f64s(&st.h_old) + f64s(&self.h_new);
+        let mut n =
+            f64s(&st.u) + st.p.capacity() + st.p_faces.capacity() + f64s(&st.h_old) + f64s(&self.h_new);
         n += self.phi.capacity() + self.rhs.capacity();
         n += self.force.as_ref().map_or(0, f64s);
         n += self
@@ -313,7 +334,7 @@ impl Flow {
         let bytes = self.kind.iter().map(Vec::capacity).sum::<usize>() + self.blocked.capacity();
         let lists: usize = (0..3)
             .map(|a| {
-                self.outlet_nodes[a].capacity() * 16
+                self.outlet_nodes[a].capacity() * std::mem::size_of::<(usize, usize, u8)>()
                     + self.solid_nodes[a].iter().map(|(_, v)| 32 + 8 * v.capacity()).sum::<usize>()
             })
             .sum();
@@ -374,7 +395,7 @@ impl Flow {
                                     (idx(g - 1), idx(g - 2), idx(g), None)
                                 };
                                 match bc {
-                                    Boundary::Outlet { .. } => {}
+                                    Boundary::Outlet { .. } | Boundary::TotalPressure { .. } => {}
                                     Boundary::Inlet { .. } => u[bnode] = vel.map_or(0.0, |v| v[a]),
                                     _ => u[bnode] = 0.0,
                                 }
@@ -395,7 +416,9 @@ impl Flow {
                                             2.0 * vel.map_or(0.0, |v| v[a]) - u[mi]
                                         }
                                         Boundary::Slip | Boundary::Axis => u[mi],
-                                        Boundary::Outlet { .. } => u[idx(if plus { g + n - 1 } else { g })],
+                                        Boundary::Outlet { .. } | Boundary::TotalPressure { .. } => {
+                                            u[idx(if plus { g + n - 1 } else { g })]
+                                        }
                                     };
                                 }
                             }
@@ -517,6 +540,7 @@ impl Flow {
     fn advance(&mut self, dt: f64) -> Result<StepReport, FlowError> {
         let l = self.grid.layout;
         let s = l.s;
+        let p_targets = self.pressure_targets(self.state.t + dt);
         let mut h_new = std::mem::take(&mut self.h_new);
         if self.turbulence.is_some() {
             self.explicit_terms::<0, true>(&mut h_new[0]);
@@ -558,7 +582,7 @@ impl Flow {
             if let Some(src) = self.implicit.as_mut() {
                 src.advance(a, &l, kind, dt, &mut self.state.u[a]);
             }
-            for &(c, src) in &self.outlet_nodes[a] {
+            for &(c, src, _) in &self.outlet_nodes[a] {
                 self.state.u[a][c] = self.state.u[a][src];
             }
         }
@@ -585,6 +609,21 @@ impl Flow {
                 }
             }
         });
+        // Dirichlet faces whose pressure changes: φ_b = p_b⁺ − p_b moves to the right-hand side with the
+        // face's coupling 2A/Δ (the half cell between the centre and the face; see `pressure_stencil`).
+        let phi_b: Vec<f64> = p_targets.iter().zip(&self.state.p_faces).map(|(t, p)| t - p).collect();
+        let mut f = 0;
+        for a in 0..3 {
+            for &(c, src, _) in &self.outlet_nodes[a] {
+                if phi_b[f] != 0.0 {
+                    let cell = if src > c { c + s[a] } else { c };
+                    let coef =
+                        2.0 * self.grid.face_area(a, l.coords(c)) / self.grid.metric[a].d[l.coords(cell)[a]];
+                    self.rhs[cell] += coef * phi_b[f];
+                }
+                f += 1;
+            }
+        }
         self.phi.iter_mut().for_each(|v| *v = 0.0);
         let rep = self.pcg.solve(&mut self.rhs, &mut self.phi, &self.numerics.pressure);
         if !rep.converged {
@@ -595,6 +634,7 @@ impl Flow {
             });
         }
         // Correction.
+        let mut f = 0;
         for a in 0..3 {
             let kind = &self.kind[a];
             let phi = &self.phi;
@@ -611,15 +651,17 @@ impl Flow {
                     }
                 }
             });
-            for &(c, src) in &self.outlet_nodes[a] {
+            for &(c, src, _) in &self.outlet_nodes[a] {
                 let q = l.coords(c);
-                // The outlet face value of φ is 0: mirror ghost −φ_interior.
+                // The face value of φ is φ_b: the gradient over the half cell is 2(φ_b − φ_P)/Δ outwards.
                 let cell = if src > c { c + s[a] } else { c };
                 let d = m.d[l.coords(cell)[a]];
                 let sign = if q[a] < GHOST { 1.0 } else { -1.0 };
-                self.state.u[a][c] -= sign * dt * 2.0 * self.phi[cell] / d;
+                self.state.u[a][c] -= sign * dt * 2.0 * (self.phi[cell] - phi_b[f]) / d;
+                f += 1;
             }
         }
+        self.state.p_faces = p_targets;
         let phi = &self.phi;
         for_planes(&l, &mut self.state.p, |k, plane| {
             let base = k * s[2];
@@ -646,6 +688,23 @@ impl Flow {
         self.state.step += 1;
         let courant = self.check(dt)?;
         Ok(StepReport { pressure: rep, courant })
+    }
+
+    /// The kinematic pressure each Dirichlet face holds at time `t` \[m²/s²\] (see
+    /// [`Boundary::static_pressure`]), from the face velocities of the current state.
+    fn pressure_targets(&self, t: f64) -> Vec<f64> {
+        let l = self.grid.layout;
+        let rho = self.fluid.density;
+        let mut out = Vec::with_capacity(self.state.p_faces.len());
+        for a in 0..3 {
+            for &(c, _, side) in &self.outlet_nodes[a] {
+                let u = self.state.u[a][c];
+                let u_in = if l.coords(c)[a] < GHOST { u } else { -u };
+                let p = self.bc[side as usize].static_pressure(t, u_in, rho).unwrap_or(0.0);
+                out.push(p / rho);
+            }
+        }
+        out
     }
 
     /// Largest Courant number; an error for NaN or Courant numbers above the limit.
@@ -692,7 +751,10 @@ impl Flow {
     }
 
     /// The largest stable time step: `courant`·min(Δx/|u|) and 0.9 of the explicit diffusion limit
-    /// Δt ≤ 1/(4ν Σ 1/Δx²) of second-order Adams–Bashforth; capped at `dt_max`.
+    /// Δt ≤ 1/(4ν Σ 1/Δx²) of second-order Adams–Bashforth; capped at `dt_max`. Where sides that hold the
+    /// pressure differ in pressure, |u| is taken at least as the Bernoulli speed of the largest difference,
+    /// √(2Δp/ρ) (see [`Flow::pressure_speed`]), over the smallest cell width: fluid at rest between them is
+    /// about to move that fast.
     pub fn stable_dt(&self, courant: f64, dt_max: f64) -> f64 {
         let l = self.grid.layout;
         let m = &self.grid.metric;
@@ -719,8 +781,30 @@ impl Flow {
             });
             diff = diff.min(0.9 / (4.0 * nu_rate));
         }
+        let u_p = self.pressure_speed(self.state.t);
+        let rate = if u_p > 0.0 {
+            let h = (0..dims).map(|a| self.grid.axes[a].min_width()).fold(f64::INFINITY, f64::min);
+            rate.max(u_p / h)
+        } else {
+            rate
+        };
         let conv = if rate > 0.0 { courant / rate } else { f64::INFINITY };
         dt_max.min(diff).min(conv)
+    }
+
+    /// The Bernoulli speed √(2Δp/ρ) \[m/s\] of the largest difference Δp between the pressures the sides
+    /// that hold the pressure have at time `t` for fluid at rest (outlets their static pressure,
+    /// total-pressure sides p₀): the fastest that difference drives the fluid without losses. 0 when
+    /// there are fewer than two such sides or they agree.
+    pub fn pressure_speed(&self, t: f64) -> f64 {
+        let rho = self.fluid.density;
+        let held: Vec<f64> = self.bc.iter().filter_map(|b| b.static_pressure(t, 0.0, rho)).collect();
+        let hi = held.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let lo = held.iter().copied().fold(f64::INFINITY, f64::min);
+        if held.len() < 2 || hi <= lo {
+            return 0.0;
+        }
+        (2.0 * (hi - lo) / rho).sqrt()
     }
 
     /// Velocity at the centre of interior cell (i, j, k) (average of the two face values per component).
@@ -790,10 +874,13 @@ impl Flow {
     /// Restores a state saved from a flow on the same grid.
     pub fn restore(&mut self, state: State) -> Result<(), FlowError> {
         let n = self.grid.layout.len();
-        if state.p.len() != n || state.u.iter().any(|v| v.len() != n) {
+        let faces: usize = self.outlet_nodes.iter().map(Vec::len).sum();
+        if state.p.len() != n || state.u.iter().any(|v| v.len() != n) || state.p_faces.len() != faces {
             return Err(FlowError::Boundaries(format!(
-                "checkpoint holds {} values per field but this grid needs {n}; was it written for another grid?",
-                state.p.len()
+                "checkpoint holds {} values per field and {} pressure-face values but this grid needs {n} and \
+                 {faces}; was it written for another grid or other boundaries?",
+                state.p.len(),
+                state.p_faces.len()
             )));
         }
         if self.turbulence.is_some() != state.turbulence.is_some() {
@@ -828,7 +915,11 @@ pub fn trilinear_stencil(grid: &Grid, comp: usize, x: [f64; 3]) -> ([usize; 3], 
 }
 
 /// The pressure-correction operator of the node kinds.
-fn pressure_stencil(grid: &Grid, kind: &[Vec<u8>; 3], outlet_nodes: &[Vec<(usize, usize)>; 3]) -> Stencil {
+fn pressure_stencil(
+    grid: &Grid,
+    kind: &[Vec<u8>; 3],
+    outlet_nodes: &[Vec<(usize, usize, u8)>; 3],
+) -> Stencil {
     let l = grid.layout;
     let mut st = Stencil::empty(l);
     st.singular = outlet_nodes.iter().all(|v| v.is_empty());
@@ -844,7 +935,7 @@ fn pressure_stencil(grid: &Grid, kind: &[Vec<u8>; 3], outlet_nodes: &[Vec<(usize
         }
     }
     for (a, list) in outlet_nodes.iter().enumerate() {
-        for &(c, src) in list {
+        for &(c, src, _) in list {
             let cell = if src > c { c + l.s[a] } else { c };
             // Face area of the outlet face (the +face of `c` along a) over half the cell width.
             let area = grid.face_area(a, l.coords(c));
