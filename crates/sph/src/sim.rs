@@ -1302,6 +1302,7 @@ impl Simulation {
         let eos = self.params.eos();
         let decomp = self.decomp.as_ref();
         let (mut s, mut n) = (0.0, 0usize);
+        let mut read = Vec::new();
         for k in 0..w.w_src.len() {
             let src = w.w_src[k] as usize;
             if w.w_ghost[k] || self.boundary.area[src] <= 0.0 || decomp.is_some_and(|d| !d.owns(w.w_pos[k])) {
@@ -1310,6 +1311,27 @@ impl Simulation {
             if (w.w_pos[k] - x).length() <= radius {
                 s += eos.pressure(w.w_rho[k]);
                 n += 1;
+                if decomp.is_some() {
+                    read.push(src as u32);
+                }
+            }
+        }
+        if let Some(d) = decomp {
+            // The first-layer wall particles this rank owns within the radius but outside its wall set have
+            // no fluid within one support: they read the dry wall state (no extrapolated pressure, the rest
+            // density), as they do on one rank.
+            read.sort_unstable();
+            let dry = eos.pressure(self.params.rest_density);
+            let b = &self.boundary;
+            for i in 0..b.len() {
+                if b.area[i] <= 0.0 || read.binary_search(&(i as u32)).is_ok() {
+                    continue;
+                }
+                let p = b.position(i);
+                if (p - x).length() <= radius && d.owns(p) {
+                    s += dry;
+                    n += 1;
+                }
             }
         }
         (s, n)
