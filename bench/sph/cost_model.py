@@ -18,13 +18,14 @@ with about 10^8 fluid particles on 16, 64 and 256 nodes, from:
 * an interconnect described by its latency and bandwidth (defaults: an InfiniBand HDR node link,
   200 Gbit/s, shared by the node's ranks; see the option help).
 
-Four ways to run are compared: every wall particle in every rank's wall set (the engine before
-2026-11-26), only the wall particles within one support of the rank's box in its wall set (the engine
-now) with one rank per core and with one rank per node and a thread per core (the wall set's per-step
-rebuild runs on one thread), and the boundary also stored only where it is needed (not built: today
-every rank holds the reference positions of every wall particle). Walls are assumed spread over the
-ranks like the water, which is optimistic: the outer boxes also hold the dry walls beyond the water,
-and the rank with the most walls sets the pace (docs/scaling.md). The scene is the `wading` example's
+Five ways to run are compared: every wall particle in every rank's wall set (the engine before
+2026-11-26); the wall particles within one support of the rank's box (2026-11-26); within one support of
+its wall region, the box cut down to the fluid it owns and receives (the engine now), with one rank per
+core and with one rank per node and a thread per core (the wall set's per-step rebuild runs on one
+thread); and the boundary also stored only where it is needed (not built: today every rank holds the
+reference positions of every wall particle). Without `--walls-from` the walls are spread over the ranks
+like the water (optimistic: the rank with the most walls sets the pace); with it the largest wall set of
+any rank comes from the example's real surfaces (`wall_spread.py`). The scene is the `wading` example's
 run as an `sph`-kind scenario without surface tension and adhesion (which do not run on ranks yet).
 Only the standard library is used. Every assumption is an option; `--help` lists them.
 """
@@ -37,6 +38,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import wall_spread
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "wading_truck.toml"
@@ -192,6 +195,10 @@ def main():
                     help="seconds to place and test one chunk of 256 wall particles against the rank's box")
     ap.add_argument("--fluid-bytes", type=float, default=412.0,
                     help="bytes held per fluid or halo particle (`spatter bench sph`)")
+    ap.add_argument("--walls-from", metavar="RUN",
+                    help="take the largest wall set of any rank from the real surfaces of this run of the "
+                         "example (its geometry/ folder, e.g. `spatter run examples/wading_truck.toml "
+                         "--smoke --out RUN`) instead of spreading the walls like the water")
     args = ap.parse_args()
 
     # The example's geometry (examples/wading_truck.toml): channel 4 m wide, water 0.3 m deep; the
@@ -224,20 +231,43 @@ def main():
           f"water {length:.2f} x {width:.1f} x {depth:.1f} m, dt = {dt:.3g} s, {steps:.3g} steps for "
           f"{drive / speed:.2f} s, halo {halo_w * 1e3:.1f} mm")
     print()
+    node_counts = [int(n) for n in args.nodes.split(",")]
+    largest = None
+    if args.walls_from:
+        # The front axle's path through the pool: 3.1 m to 11 m.
+        shifts = [0.0, 0.33 * drive, 0.67 * drive, drive]
+        rank_counts = sorted({n * c for n in node_counts for c in (1, args.cores_per_node)})
+        largest = wall_spread.largest_wall_sets(Path(args.walls_from) / "geometry", depth, rank_counts, dp,
+                                                walls, shifts)
+        print("largest wall set of any rank from the example's surfaces (the truck at four places on its "
+              "path; spread like the water: walls / ranks):")
+        print()
+        print("| ranks | spread like the water | within a support of the box | within a support of the "
+              "wall region (largest) | wall region (mean) |")
+        print("|---|---|---|---|---|")
+        for r in rank_counts:
+            by_box, by_region, mean = largest[r]
+            print(f"| {r} | {walls / r:.3g} | {by_box:.3g} | {by_region:.3g} | {mean:.3g} |")
+        print()
     print("| layout | nodes | ranks | fluid per rank | halo / fluid | peers (mean, max) | fluid + halo [ms] "
           "| walls [ms] | messages [ms] | step [ms] | wall time [h] | core-hours | memory per node [GB] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     cores = args.cores_per_node
     lat = args.latency_us * 1e-6
     layouts = [
-        # (name, one rank per node, only the walls near the box in the wall set, boundary stored split)
-        ("every wall in every rank's wall set (before 2026-11-26), rank per core", False, False, False),
-        ("walls near the box, rank per core", False, True, False),
-        ("walls near the box, rank per node", True, True, False),
-        ("walls near the box and stored only there (not built), rank per core", False, True, True),
+        # (name, one rank per node, which walls a rank's wall set holds, boundary stored split)
+        ("every wall in every rank's wall set (before 2026-11-26), rank per core", False, "all", False),
+        ("walls near the box (2026-11-26), rank per core", False, "box", False),
+        ("walls near the fluid, rank per core", False, "region", False),
+        ("walls near the fluid, rank per node", True, "region", False),
+        ("walls near the fluid and stored only there (not built), rank per core", False, "region", True),
     ]
-    for nodes in (int(n) for n in args.nodes.split(",")):
-        for name, per_node, local, stored in layouts:
+    if largest is None:
+        # Spread like the water, both rules alike: keep one of the two rows.
+        layouts = [l for l in layouts if l[2] != "box"]
+    for nodes in node_counts:
+        for name, per_node, held_rule, stored in layouts:
+            local = held_rule != "all"
             ranks = nodes if per_node else nodes * cores
             speedup = cores * args.thread_efficiency if per_node else 1.0
             n_rank = args.particles / ranks
@@ -245,7 +275,13 @@ def main():
             # The walls within one support of a box: its share, plus the band one support wide around
             # it (counted like the fluid's halo at that width: an upper bound for surfaces).
             band = decomposition(ranks, water, support, dp)[0] / n_rank
-            w_set = walls / ranks * (1.0 + band) if local else walls
+            if not local:
+                w_set = walls
+            elif largest is None:
+                w_set = walls / ranks * (1.0 + band)
+            else:
+                # The rank with the most walls sets the pace (it owns as much fluid as the others).
+                w_set = largest[ranks][0 if held_rule == "box" else 1]
             compute = (cf * n_rank + args.halo_cost * halo) / speedup
             # The per-step rebuild of the wall set (`build_wall_set`) is a serial loop, so the walls of
             # a rank of many threads are charged to one thread; the chunk tests run on all of them.

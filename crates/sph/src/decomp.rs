@@ -73,11 +73,44 @@ impl Decomp {
         self.rcb.owner(x) == self.rank
     }
 
-    /// This rank's box (the region whose walls it needs, within one support of it).
-    pub(super) fn rank_region(&self) -> Aabb {
-        self.boxes[self.rank]
+    /// The region whose walls this rank needs (it selects those within one support of it), or `None`
+    /// when no fluid is near and it needs none: its box, cut down to one support around the fluid it
+    /// owns or receives (`owned`, `halo`), widened outward to multiples of [`WALL_REGION_STEP`]
+    /// supports from the world origin.
+    ///
+    /// That covers every wall particle within one support of the rank's own fluid (the walls its
+    /// particles interact with) and every wall particle in its box that any fluid reaches (the ones
+    /// whose wetting and loads it accounts for: fluid within one support of its box is in its halo).
+    /// The outer boxes of the split reach to infinity; without the cut a rank at the water's edge would
+    /// hold every dry wall beyond it — the approach road, the channel walls above the water line, the
+    /// vehicle's body — and in a large wading run one such rank would hold about 10⁶ wall particles
+    /// against a few thousand on the others (docs/scaling.md). The widening makes the region change only
+    /// when the fluid has moved by about a step, so that static walls are reselected rarely; it depends
+    /// on the current positions only, so a resumed run selects exactly what the uninterrupted run held.
+    pub(super) fn wall_region(&self, owned: &[Vec3], halo: &[Vec3], support: f64) -> Option<Aabb> {
+        let bounds = |x: &[Vec3]| {
+            x.par_iter()
+                .with_min_len(4096)
+                .fold(|| Aabb::EMPTY, |b, &p| b.grown_to(p))
+                .reduce(|| Aabb::EMPTY, Aabb::union)
+        };
+        let near = bounds(owned).union(bounds(halo));
+        if near.is_empty() {
+            return None;
+        }
+        let step = WALL_REGION_STEP * support;
+        let near = Aabb::new(
+            ((near.min - Vec3::splat(support)) / step).floor() * step,
+            ((near.max + Vec3::splat(support)) / step).ceil() * step,
+        );
+        let b = self.boxes[self.rank];
+        let region = Aabb::new(b.min.max(near.min), b.max.min(near.max));
+        (!region.is_empty()).then_some(region)
     }
 }
+
+/// The lattice, in kernel supports, that a rank's wall region is widened to ([`Decomp::wall_region`]).
+const WALL_REGION_STEP: f64 = 2.0;
 
 /// What one rank saw in its part of a step, before the reductions.
 #[derive(Clone, Copy, Debug, Default)]
@@ -285,13 +318,19 @@ impl Simulation {
 
     /// This rank's box, when the fluid is split.
     pub fn rank_box(&self) -> Option<Aabb> {
-        self.decomp.as_ref().map(|d| d.rank_region())
+        self.decomp.as_ref().map(|d| d.boxes[d.rank])
     }
 
     /// Wall entries (wall particles and their periodic images) in this rank's wall set: on several ranks
-    /// only those within one kernel support of its box (module `local_walls`).
+    /// only those near its box and its fluid (module `local_walls`, [`Decomp::wall_region`]).
     pub fn wall_entries(&self) -> usize {
         self.work.w_src.len()
+    }
+
+    /// The boundary index of every entry of this rank's wall set, in the set's order (an index appears
+    /// once more for each periodic image).
+    pub fn wall_sources(&self) -> &[u32] {
+        &self.work.w_src
     }
 
     /// Halo particles received and particles migrated in the last step on this rank.

@@ -1,9 +1,12 @@
 //! The wall particles a rank needs: on several ranks every rank holds the whole boundary (its reference
-//! positions and frames), but only the wall particles within one kernel support of its box enter its
-//! wall set — the ones its own fluid can see. Everything a step does per wall particle (placing it,
-//! binning it, its extrapolated state, its wet flag) then scales with the rank's share of the walls
-//! instead of with all of them (docs/scaling.md: with every wall on every rank a 10⁸-particle wading
-//! case spends seconds per step on walls whatever the number of ranks).
+//! positions and frames), but only the wall particles within one kernel support of its wall region
+//! enter its wall set — its box cut down to the neighbourhood of the fluid it owns and receives
+//! (`Decomp::wall_region`): the walls its own fluid can see and the walls in its box any fluid reaches.
+//! Everything a step does per wall particle (placing it, binning it, its extrapolated state, its wet
+//! flag) then scales with the rank's share of the wetted walls instead of with all of them
+//! (docs/scaling.md: with every wall on every rank a 10⁸-particle wading case spends seconds per step on
+//! walls whatever the number of ranks, and with the whole box a rank at the water's edge holds the dry
+//! road and the vehicle beyond it).
 //!
 //! To avoid even placing every wall particle each step, a part's particles are grouped in chunks of
 //! [`CHUNK`] consecutive indices with their bounding box in the part's reference frame; a chunk whose

@@ -151,10 +151,14 @@ struct Work {
     w_tmp_b: Vec<bool>,
     /// Fluid particles with a wall entry within the cut-off (set by the wall pass).
     w_touched: pass::WallFlags,
-    /// On several ranks: the wall particles within one support of this rank's box.
+    /// On several ranks: the wall particles within one support of this rank's wall region.
     w_local: LocalWalls,
     /// Boundary size when the wall set was built.
     w_built_len: usize,
+    /// The wall region the set was selected for (`None`: one rank, the whole boundary).
+    w_region: Option<Option<Aabb>>,
+    /// Boundary indices of the set being replaced (scratch of the wall set's rebuild on several ranks).
+    w_left: Vec<u32>,
     walls_built: bool,
     ready: bool,
     times: PhaseTimes,
@@ -640,23 +644,35 @@ impl Simulation {
         let origin = self.coords_origin();
         let w = &mut self.work;
         let b = &self.boundary;
+        // On several ranks only the walls within one support of the rank's wall region: the ones its fluid
+        // sees and the ones in its box any fluid reaches (module `local_walls`, `Decomp::wall_region`).
+        // `None` inside means no fluid near: no walls.
+        let region = self.decomp.as_ref().map(|d| d.wall_region(&self.fluid.pos, &w.g_pos, support));
         if w.walls_built
             && !periodic
             && !b.any_moving()
             && w.w_built_len == b.len()
             && w.w_c32.origin() == origin
+            && w.w_region == region
         {
             return;
         }
         w.w_built_len = b.len();
+        w.w_region = region;
+        if region.is_some() {
+            // The entries of the set being replaced, to clear the wet flags of those that leave it.
+            w.w_left.clear();
+            w.w_left.extend_from_slice(&w.w_src);
+        }
         w.w_src.clear();
         w.w_ghost.clear();
         w.w_pos.clear();
-        // On several ranks only the walls within one support of the rank's box: the ones its fluid sees
-        // (module `local_walls`). Periodic runs select after adding the images, below.
-        let region = self.decomp.as_ref().map(|d| d.rank_region());
+        // Periodic runs select after adding the images, below.
         match region {
-            Some(region) if !periodic => w.w_local.select(b, &region, support, &mut w.w_src, &mut w.w_pos),
+            Some(None) => {}
+            Some(Some(region)) if !periodic => {
+                w.w_local.select(b, &region, support, &mut w.w_src, &mut w.w_pos)
+            }
             _ => {
                 for i in 0..b.len() {
                     w.w_src.push(i as u32);
@@ -684,7 +700,7 @@ impl Simulation {
                 }
             }
         }
-        if let (Some(region), true) = (region, periodic) {
+        if let (Some(Some(region)), true) = (region, periodic) {
             let mut k = 0;
             for j in 0..w.w_src.len() {
                 if point_gap(w.w_pos[j], &region) <= support {
@@ -727,6 +743,29 @@ impl Simulation {
         w.w_irho.resize(n, 0.0);
         w.w_wet.resize(n, false);
         w.walls_built = true;
+        if region.is_some() {
+            self.dry_walls_that_left();
+        }
+    }
+
+    /// On several ranks, after the wall set was reselected: a wall particle that left it has no fluid
+    /// within one support (the region covers every wall particle any fluid reaches in the rank's box), so
+    /// it is dry; only entries of the set get their wet flag from the wetting pass, so clear it here.
+    /// Usually it has dried in the pass already (the set reaches two supports beyond the fluid, which
+    /// moves less than a spacing per step); not so when a fluid particle next to it was removed (it left
+    /// the domain or the density window).
+    fn dry_walls_that_left(&mut self) {
+        let w = &mut self.work;
+        // `w_tmp_u` is scratch after the permutation; it holds the new set in selection order.
+        w.w_tmp_u.clear();
+        w.w_tmp_u.extend_from_slice(&w.w_src);
+        w.w_tmp_u.sort_unstable();
+        for &s in &w.w_left {
+            if w.w_tmp_u.binary_search(&s).is_err() {
+                self.boundary.wet[s as usize] = false;
+            }
+        }
+        w.w_left.clear();
     }
 
     /// Origin of the single-precision coordinates of the cut-off test: the lower corner of the domain
@@ -1263,6 +1302,7 @@ impl Simulation {
         let eos = self.params.eos();
         let decomp = self.decomp.as_ref();
         let (mut s, mut n) = (0.0, 0usize);
+        let mut read = Vec::new();
         for k in 0..w.w_src.len() {
             let src = w.w_src[k] as usize;
             if w.w_ghost[k] || self.boundary.area[src] <= 0.0 || decomp.is_some_and(|d| !d.owns(w.w_pos[k])) {
@@ -1271,6 +1311,27 @@ impl Simulation {
             if (w.w_pos[k] - x).length() <= radius {
                 s += eos.pressure(w.w_rho[k]);
                 n += 1;
+                if decomp.is_some() {
+                    read.push(src as u32);
+                }
+            }
+        }
+        if let Some(d) = decomp {
+            // The first-layer wall particles this rank owns within the radius but outside its wall set have
+            // no fluid within one support: they read the dry wall state (no extrapolated pressure, the rest
+            // density), as they do on one rank.
+            read.sort_unstable();
+            let dry = eos.pressure(self.params.rest_density);
+            let b = &self.boundary;
+            for i in 0..b.len() {
+                if b.area[i] <= 0.0 || read.binary_search(&(i as u32)).is_ok() {
+                    continue;
+                }
+                let p = b.position(i);
+                if (p - x).length() <= radius && d.owns(p) {
+                    s += dry;
+                    n += 1;
+                }
             }
         }
         (s, n)
