@@ -71,8 +71,7 @@ const SIN_TRANS: f64 = 0.5;
 
 /// Damping ratio ξ = −ln e / √(π² + ln² e) of a linear spring–dashpot with restitution e.
 pub fn damping_ratio(e: f64) -> f64 {
-    let l = e.ln();
-    -l / (std::f64::consts::PI.powi(2) + l * l).sqrt()
+    -crate::contact::restitution_fit::beta(e)
 }
 
 /// Largest overlap of a linear spring–dashpot impact, Jasion Eq. B.6 (after Tuley et al. 2010):

@@ -142,7 +142,10 @@ impl WearTable {
 mod tests {
     use super::*;
 
-    /// f(γ) table of the stone-chip verification plan (values of sin 2γ − 3 sin²γ and cos²γ/3).
+    /// f(γ) of Finnie (1960, Wear 3:87–103) in the form of the stone-chip study (Qian et al. 2022, CMES):
+    /// the two branches sin 2γ − 3 sin²γ and cos²γ/3 tabulated to five decimals (tolerance 5e-6);
+    /// f(90°) = 0, f(54°) = 0.11516, the maximum 0.30278 at ½ atan(2/3) = 16.845° (angle to 1e-3°), the
+    /// branches meeting at 0.3 where tan γ = 1/3 (18.435°).
     #[test]
     fn finnie_angle_function_matches_the_table() {
         let table = [
@@ -166,7 +169,9 @@ mod tests {
         // Continuous at tan γ = 1/3 (both branches 0.3); the maximum at ½ atan(2/3).
         let g = (1.0f64 / 3.0).atan();
         assert!((finnie_f(g - 1e-12) - 0.3).abs() < 1e-10 && (finnie_f(g + 1e-12) - 0.3).abs() < 1e-10);
+        assert!((g.to_degrees() - 18.435).abs() < 1e-3 && (finnie_f(g) - 0.3).abs() < 1e-12);
         let gmax = 0.5 * (2.0f64 / 3.0).atan();
+        assert!((gmax.to_degrees() - 16.845).abs() < 1e-3);
         assert!((finnie_f(gmax) - 0.302_775_637_7).abs() < 1e-9);
         for k in 0..1000 {
             assert!(finnie_f(k as f64 * 1.5708e-3) <= finnie_f(gmax) + 1e-15);

@@ -193,6 +193,45 @@ mod tests {
     }
 
     #[test]
+    fn di_felice_tables_of_cd_and_chi() {
+        // Di Felice (1994), Int. J. Multiphase Flow 20:153–159: C_d = (0.63 + 4.8/√Re)² and
+        // χ = 3.7 − 0.65 exp(−(1.5 − log₁₀ Re)²/2) over 1 ≤ Re ≤ 1e5, values as printed (4 or 5
+        // decimals): tolerance half a unit of the last printed digit.
+        let law = DragLaw::DiFelice { voidage: None };
+        let half_digit = |decimals: i32| 0.5 * 10f64.powi(-decimals);
+        for (re, cd, dec) in [
+            (1.0, 29.4849, 4),
+            (10.0, 4.61345, 5),
+            (100.0, 1.2321, 4),
+            (1e3, 0.61119, 5),
+            (1e4, 0.45968, 5),
+            (1e5, 0.41626, 5),
+        ] {
+            assert!((di_felice_cd(re) - cd).abs() < half_digit(dec), "C_d({re}) = {}", di_felice_cd(re));
+            // The engine's law (written as the factor C_d Re/24 to stay finite at Re = 0) is the same.
+            assert!((law.cd(re) - cd).abs() < half_digit(dec), "DragLaw C_d({re}) = {}", law.cd(re));
+        }
+        for (re, chi) in [
+            (1.0, 3.48898),
+            (10.0, 3.12638),
+            (100.0, 3.12638),
+            (1e3, 3.48898),
+            (1e4, 3.67144),
+            (1e5, 3.69858),
+        ] {
+            assert!((di_felice_chi(re) - chi).abs() < half_digit(5), "χ({re}) = {}", di_felice_chi(re));
+        }
+        // The minimum 3.05 at Re = 10^1.5, symmetric in log₁₀ Re about it.
+        let min = 10f64.powf(1.5);
+        assert!((di_felice_chi(min) - 3.05).abs() < 1e-12);
+        for k in 1..100 {
+            let x = 0.05 * k as f64;
+            let (lo, hi) = (di_felice_chi(min / 10f64.powf(x)), di_felice_chi(min * 10f64.powf(x)));
+            assert!(lo > 3.05 && hi > 3.05 && (lo - hi).abs() < 1e-12, "log Re ±{x}: {lo} {hi}");
+        }
+    }
+
+    #[test]
     fn di_felice_voidage_factor_raises_drag() {
         // ε = 0.6 at Re = 10: factor relative to the single particle = ε^(1−χ(6)) · C_D(6)·6/(C_D(10)·10).
         let single = DragLaw::DiFelice { voidage: None };

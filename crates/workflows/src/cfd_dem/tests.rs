@@ -51,6 +51,74 @@ fn the_fluid_receives_exactly_the_momentum_the_spheres_lose() {
 }
 
 #[test]
+fn a_coupling_step_spans_exactly_n_dem_steps_and_holds_the_fluid_force_after_the_first_half_kick() {
+    // Anchor A11 of the stone-chip verification (Qian et al. 2022, CMES): one fluid step per N DEM steps
+    // (default N = 10), the fluid force on every sphere computed once per coupling step and held.
+    // Observables: the DEM's step counter and clock advance by exactly N steps and N Δt per coupling
+    // step, the fluid clock by the same Δt_f. Each free sphere then moves under the force F_k the
+    // exchange wrote, except that velocity Verlet's first half-kick of the coupling step still uses the
+    // forces evaluated at the end of the previous one, with F_(k−1) (docs/cfd.md, section 13, explicit
+    // exchange): Δv = ½ Δt a_(k−1) + (N − ½) Δt a_k and Δx = N Δt v₀ + ½ Δt² (N (N − 1) a_k +
+    // N a_(k−1)), a = F/m + g, to round-off (1e-12 of the terms); in the first coupling step
+    // (forces not yet evaluated) a_(k−1) = a_k. Spheres much slower than the water change their force
+    // between coupling steps, so the lag is visible: it is asserted to exceed round-off by far.
+    assert_eq!(CouplingOptions::default().dem_steps_per_fluid_step, 10);
+    let inlet = Boundary::Inlet { velocity_m_s: [0.0, 0.0, 0.05], table: Default::default() };
+    let outlet = Boundary::Outlet { pressure_pa: 0.0 };
+    let slip = Boundary::Slip;
+    let bc = [slip.clone(), slip.clone(), slip.clone(), slip, inlet, outlet];
+    let mut f = flow([4, 4, 8], 4e-3, bc).unwrap();
+    f.step(1e-3).unwrap();
+    let dt = 1e-4;
+    let mut d = dem(dt);
+    for k in 0..8 {
+        let x = Vec3::new(
+            4e-3 + 8e-3 * (k % 2) as f64,
+            5e-3 + 6e-3 * ((k / 2) % 2) as f64,
+            6e-3 + 1.2e-2 * (k / 4) as f64,
+        );
+        let mut p = NewParticle::at(x, 2e-4 + 2e-5 * k as f64, 0);
+        p.vel = Vec3::new(0.01 * (k as f64 - 4.0), -0.005, -0.02);
+        d.add_particle(p);
+    }
+    let mut c = Coupled::new(f, d, CouplingOptions::default()).unwrap();
+    assert!((c.fluid_dt() - 10.0 * dt).abs() < 1e-18);
+    let n = 10.0;
+    let mut a_prev: Option<Vec<Vec3>> = None;
+    let mut largest_lag: f64 = 0.0;
+    for round in 0..3 {
+        let (steps0, t0, tf0) = (c.dem.step_count(), c.dem.time(), c.flow.state.t);
+        let (x0, v0) = (c.dem.particles.pos.clone(), c.dem.particles.vel.clone());
+        c.step().unwrap();
+        assert_eq!(c.dem.step_count() - steps0, 10, "round {round}: DEM steps in one coupling step");
+        assert!((c.dem.time() - t0 - n * dt).abs() < 1e-15, "round {round}: DEM clock");
+        assert!((c.flow.state.t - tf0 - n * dt).abs() < 1e-15, "round {round}: fluid clock");
+        let p = &c.dem.particles;
+        let a: Vec<Vec3> = (0..p.len()).map(|i| p.ext_force[i] * p.inv_mass[i] + c.dem.gravity).collect();
+        for i in 0..p.len() {
+            let old = a_prev.as_ref().map_or(a[i], |ap| ap[i]);
+            let want_v = 0.5 * dt * old + (n - 0.5) * dt * a[i];
+            let dv = p.vel[i] - v0[i];
+            let scale_v = n * dt * (a[i].length() + old.length());
+            assert!(
+                (dv - want_v).length() < 1e-12 * scale_v,
+                "round {round}, sphere {i}: Δv {dv} vs {want_v}"
+            );
+            let want_x = n * dt * v0[i] + 0.5 * dt * dt * (n * (n - 1.0) * a[i] + n * old);
+            let scale_x = (n * dt * v0[i]).length() + 0.5 * (n * dt).powi(2) * (a[i].length() + old.length());
+            let dx = p.pos[i] - x0[i];
+            assert!(
+                (dx - want_x).length() < 1e-12 * scale_x,
+                "round {round}, sphere {i}: Δx {dx} vs {want_x}"
+            );
+            largest_lag = largest_lag.max((0.5 * dt * (old - a[i])).length() / scale_v);
+        }
+        a_prev = Some(a);
+    }
+    assert!(largest_lag > 1e-6, "the half-kick lag {largest_lag:e} is visible above round-off");
+}
+
+#[test]
 fn a_fixed_bed_has_the_ergun_pressure_drop() {
     fixed_bed_against_ergun(Exchange::Explicit);
 }

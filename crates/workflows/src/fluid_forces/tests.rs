@@ -26,7 +26,18 @@ fn uniform(u: Vec3) -> AnalyticSet {
 }
 
 fn sim_in(u: Vec3, drag: DragModel, dt: f64) -> Simulation<HertzMindlin> {
-    let mats = vec![glass()];
+    sim_in_fluid(water(), glass(), u, drag, dt)
+}
+
+/// One-material DEM scene in the uniform flow `u` of `fluid` with gravity [`G`] and drag law `drag`.
+fn sim_in_fluid(
+    fluid: Fluid,
+    material: Material,
+    u: Vec3,
+    drag: DragModel,
+    dt: f64,
+) -> Simulation<HertzMindlin> {
+    let mats = vec![material];
     let mut sim = Simulation::new(
         HertzMindlin::default(),
         mats.clone(),
@@ -35,8 +46,8 @@ fn sim_in(u: Vec3, drag: DragModel, dt: f64) -> Simulation<HertzMindlin> {
         Settings::default(),
     );
     sim.gravity = G;
-    let options = FluidForceOptions { fluid: water(), drag, ..Default::default() };
-    let sampler = PrescribedFlow::new(uniform(u), water().density, G);
+    let options = FluidForceOptions { fluid, drag, ..Default::default() };
+    let sampler = PrescribedFlow::new(uniform(u), fluid.density, G);
     sim.set_external_forces(Box::new(FluidForces::new(sampler, options)));
     sim
 }
@@ -77,6 +88,43 @@ fn a_sphere_in_a_uniform_flow_reaches_the_schiller_naumann_terminal_velocity() {
     assert!((v.x / u.x - 1.0).abs() < 1e-6, "v = {v}");
     assert!(((u.z - v.z) / wt - 1.0).abs() < 1e-6, "slip {} vs w_t {wt}", u.z - v.z);
     assert!(v.y.abs() < 1e-12);
+}
+
+#[test]
+fn a_steel_ball_settles_in_still_air_at_the_di_felice_terminal_velocity() {
+    // Anchor A9 of the stone-chip verification (Qian et al. 2022, CMES): one sphere falling from rest in
+    // still air (void fraction 1) under the drag law of Di Felice (1994), C_d = (0.63 + 4.8/√Re)²,
+    // reaches v_t solving m g (1 − ρ_f/ρ_p) = (π/8) C_d(Re) ρ_f d² v_t², Re = ρ_f d v_t/μ, solved here
+    // by bisection on v. The 5 mm steel ball of the study's single-particle tests in air at 20 °C:
+    // v_t ≈ 32 m/s, Re ≈ 1e4. From rest the speed approaches v_t as tanh(g t/v_t) for a constant C_d,
+    // so after 40 s the transient is below 1e-10; at the terminal state the forces balance whatever
+    // the step. Tolerance 1e-6 relative.
+    let air = Fluid { density: 1.204, viscosity: 1.81e-5 };
+    let (d, rho_p) = (5e-3, 7850.0);
+    let steel = Material::new(2e11, 0.3, rho_p).unwrap();
+    let mut sim = sim_in_fluid(air, steel, Vec3::ZERO, DragModel::DiFelice, 1e-3);
+    sim.add_particle(NewParticle::at(Vec3::ZERO, 0.5 * d, 0));
+    sim.run_steps(40_000).unwrap();
+    let weight = rho_p * PI / 6.0 * d.powi(3) * 9.81 * (1.0 - air.density / rho_p);
+    let resid = |v: f64| {
+        let re = air.density * d * v / air.viscosity;
+        let cd = (0.63 + 4.8 / re.sqrt()).powi(2);
+        PI / 8.0 * cd * air.density * d * d * v * v - weight
+    };
+    let (mut lo, mut hi) = (0.0, 1e3);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if resid(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let vt = 0.5 * (lo + hi);
+    let v = sim.particles.vel[0];
+    assert!((-v.z / vt - 1.0).abs() < 1e-6, "settling {} m/s vs v_t {vt} m/s", -v.z);
+    assert!(v.x.abs() < 1e-12 && v.y.abs() < 1e-12, "v = {v}");
+    assert!(vt > 25.0 && vt < 40.0, "v_t {vt} m/s: the Newton regime of the study's ball");
 }
 
 #[test]
