@@ -11,7 +11,6 @@
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
 use spatter_core::Vec3;
-use spatter_dem::clump::NO_BODY;
 use spatter_dem::contact::ContactLaw;
 use spatter_dem::sim::{Simulation, WallImpact};
 use std::collections::BTreeMap;
@@ -207,7 +206,7 @@ impl EventLog {
             for k in 0..bodies.len() {
                 check((true, bodies.id[k]), bodies.template[k] as i64, bodies.pos[k], bodies.vel[k], self);
             }
-            for i in (0..p.len()).filter(|&i| p.body[i] == NO_BODY) {
+            for i in (0..p.len()).filter(|&i| !p.is_member(i)) {
                 check((false, p.id[i]), -1, p.pos[i], p.vel[i], self);
             }
         }
@@ -335,8 +334,7 @@ pub fn trajectory_rows<L: ContactLaw>(sim: &Simulation<L>, cfg: &TrajectoryConfi
         let q = b.quat[k];
         rows.push(trajectory_row(t, true, b.id[k], b.pos[k], b.vel[k], [q.w, q.x, q.y, q.z], b.omega[k]));
     }
-    let mut spheres: Vec<usize> =
-        (0..p.len()).filter(|&i| p.body[i] == NO_BODY && cfg.follows(p.id[i])).collect();
+    let mut spheres: Vec<usize> = (0..p.len()).filter(|&i| !p.is_member(i) && cfg.follows(p.id[i])).collect();
     spheres.sort_by_key(|&i| p.id[i]);
     for i in spheres {
         rows.push(trajectory_row(t, false, p.id[i], p.pos[i], p.vel[i], [1.0, 0.0, 0.0, 0.0], p.omega[i]));

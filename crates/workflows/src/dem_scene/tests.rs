@@ -822,6 +822,37 @@ fn the_event_log_records_first_impacts_and_plane_crossings_and_resumes() {
     assert_eq!(scalar(&s, "objects_crossed_plane"), Some(1.0));
 }
 
+/// A scene of free spheres only (no clump templates: the particles carry no body index at all) with a
+/// crossing plane and trajectories: the event log and the trajectories are written (the sphere crosses
+/// x = 0.03 m moving along +x, one trajectory row every 100 steps) — reading the missing body index
+/// panicked before.
+#[test]
+fn events_and_trajectories_of_a_scene_without_clumps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = events_toml(tmp.path());
+    let start = text.find("[templates.pebble]").unwrap();
+    let end = text.find("[output.events]").unwrap();
+    let fill = text[start..end].find("[[fill]]").unwrap();
+    // Keep the first fill (the free sphere), drop the template and the clump fill.
+    let second = text[start + fill + 8..end].find("[[fill]]").unwrap() + start + fill + 8;
+    let text = format!("{}{}{}", &text[..start], &text[start + fill..second], &text[end..]);
+    assert!(!text.contains("pebble"), "{text}");
+    let cfg = parse(&text);
+    Checker::run(&cfg, None).unwrap();
+    let dir = RunDir::create(&tmp.path().join("run")).unwrap();
+    let s = run(&cfg, &RunContext::new(&dir, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.finished, Finished::Completed);
+    let (head, rows) = csv_rows(&dir.root().join("events.csv"));
+    let col = |k: &str| head.iter().position(|h| h == k).unwrap_or_else(|| panic!("no column {k}: {head:?}"));
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert_eq!((rows[0][col("body")], rows[0][col("template")]), (0.0, -1.0));
+    assert!((rows[0][col("crossing_x_m")] - 0.03).abs() < 2e-5);
+    assert!(rows[0][col("crossing_dir_x")] > 0.5);
+    let (_, trows) = csv_rows(&dir.root().join("trajectories.csv"));
+    assert_eq!(trows.len(), 30);
+    assert_eq!(scalar(&s, "objects_crossed_plane"), Some(1.0));
+}
+
 /// A tyre wall on a wheel node (ω = 5 rad/s about y through (0, 0, 0.4)) whose parent chassis drives at
 /// 2 m/s along x: rolling without slip (v = ωR with R = 0.4 m). Analytic: the wall point at the origin at
 /// t = 0 is at (2t − 0.4 sin 5t, 0, 0.4 − 0.4 cos 5t), the contact point is at rest, the top moves at 4 m/s.
