@@ -9,7 +9,10 @@ plus the water depth) on a lattice; the split is the engine's recursive coordina
 walls are the surfaces of the run's `geometry/*.stl` cut into pieces no wider than a sampling spacing,
 each counting its area. Wall particles are taken proportional to area (the run's total over its total
 area). Distances are per axis (a box test), which counts a few more pieces near box corners than the
-engine's Euclidean test. Spray is not modelled: a drop thrown far from the water widens its rank's region.
+engine's Euclidean test. The fluid a rank receives is taken as its own water's bounds widened by the
+halo width; the engine's halo is the fluid within that width of the rank's box, which along a long cut
+face can reach farther, so the regions here may be slightly small. Spray is not modelled: a drop thrown
+far from the water widens its rank's region.
 Only the standard library is used.
 """
 

@@ -136,7 +136,8 @@ fn channel_speed(dp: f64, ny: usize) -> (f64, f64) {
 
 #[test]
 fn laminar_channel_between_total_and_static_pressure_carries_the_poiseuille_flow() {
-    // Energy balance from the still reservoir behind the total-pressure side to the outlet (kinematic):
+    // Mean-pressure balance from the still reservoir behind the total-pressure side to the outlet
+    // (kinematic):
     //   (p₀ − p_out)/ρ = ½βU² + 12νUL/h² + ½K U²,
     // with 12νUL/h² the plane-Poiseuille drop (White, Viscous Fluid Flow §3-3), β = 6/5 the mean of
     // u²/U² over the parabolic profile the zero-gradient inflow carries in at this Reynolds number (the

@@ -699,5 +699,8 @@ impl Simulation {
         }
         self.boundary.wet = wet;
         self.boundary.wet_time = time;
+        // Flags of wall particles outside this rank's wall set are never rewritten while they stay out:
+        // the next wall set build clears them again.
+        self.work.walls_built = false;
     }
 }

@@ -660,9 +660,16 @@ impl Simulation {
         w.w_built_len = b.len();
         w.w_region = region;
         if region.is_some() {
-            // The entries of the set being replaced, to clear the wet flags of those that leave it.
+            // The entries of the set being replaced, to clear the wet flags of those that leave it; at the
+            // first build (after a split, a resume or a gather of the wetting records) every wet flag, so
+            // that afterwards every wall particle outside the set is dry on this rank, as in a run that
+            // stepped on.
             w.w_left.clear();
-            w.w_left.extend_from_slice(&w.w_src);
+            if w.walls_built {
+                w.w_left.extend_from_slice(&w.w_src);
+            } else {
+                w.w_left.extend((0..b.len()).filter(|&i| b.wet[i]).map(|i| i as u32));
+            }
         }
         w.w_src.clear();
         w.w_ghost.clear();

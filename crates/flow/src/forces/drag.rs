@@ -195,8 +195,9 @@ mod tests {
     #[test]
     fn di_felice_tables_of_cd_and_chi() {
         // Di Felice (1994), Int. J. Multiphase Flow 20:153–159: C_d = (0.63 + 4.8/√Re)² and
-        // χ = 3.7 − 0.65 exp(−(1.5 − log₁₀ Re)²/2) over 1 ≤ Re ≤ 1e5, values as printed (4 or 5
-        // decimals): tolerance half a unit of the last printed digit.
+        // χ = 3.7 − 0.65 exp(−(1.5 − log₁₀ Re)²/2) over 1 ≤ Re ≤ 1e5. The paper gives the formulas; the
+        // values (4 or 5 decimals) are the stone-chip verification set's, computed from them by hand:
+        // tolerance half a unit of their last digit.
         let law = DragLaw::DiFelice { voidage: None };
         let half_digit = |decimals: i32| 0.5 * 10f64.powi(-decimals);
         for (re, cd, dec) in [

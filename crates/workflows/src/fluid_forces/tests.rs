@@ -60,10 +60,14 @@ fn schiller_naumann_terminal(d: f64, rho_p: f64, f: &Fluid, g: f64) -> f64 {
         let cd = 24.0 / re * (1.0 + 0.15 * re.powf(0.687));
         0.125 * cd * f.density * PI * d * d * w * w - (rho_p - f.density) * g * PI / 6.0 * d.powi(3)
     };
-    let (mut lo, mut hi) = (1e-9, 10.0);
+    increasing_root(resid, 1e-9, 10.0)
+}
+
+/// The root of `f`, negative at `lo` and positive at `hi`, by 200 bisections.
+fn increasing_root(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if resid(mid) > 0.0 {
+        if f(mid) > 0.0 {
             hi = mid;
         } else {
             lo = mid;
@@ -111,16 +115,7 @@ fn a_steel_ball_settles_in_still_air_at_the_di_felice_terminal_velocity() {
         let cd = (0.63 + 4.8 / re.sqrt()).powi(2);
         PI / 8.0 * cd * air.density * d * d * v * v - weight
     };
-    let (mut lo, mut hi) = (0.0, 1e3);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if resid(mid) > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    let vt = 0.5 * (lo + hi);
+    let vt = increasing_root(resid, 0.0, 1e3);
     let v = sim.particles.vel[0];
     assert!((-v.z / vt - 1.0).abs() < 1e-6, "settling {} m/s vs v_t {vt} m/s", -v.z);
     assert!(v.x.abs() < 1e-12 && v.y.abs() < 1e-12, "v = {v}");
