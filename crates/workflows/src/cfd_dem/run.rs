@@ -313,45 +313,46 @@ fn drive<L: ContactLaw>(
     let resumed: Option<RunState<L::State>> =
         if ctx.resume && ckpt.exists() { Some(ctx.load_checkpoint()?) } else { None };
     let mut flow = flow;
-    let (mut st, mut series, mut probes, mut fields, mut particles, mut trajectories, mut meshes) = match resumed {
-        Some(mut st) => {
-            sim.restore(std::mem::replace(&mut st.sim, sim.state()))
-                .map_err(|e| CfdDemError::Dem(DemError::Resume(e)))?;
-            flow.restore(st.flow.clone())?;
-            if st.injectors.len() != injectors.len() {
-                return Err(CfdDemError::Dem(DemError::Resume("the number of injectors changed".into())));
+    let (mut st, mut series, mut probes, mut fields, mut particles, mut trajectories, mut meshes) =
+        match resumed {
+            Some(mut st) => {
+                sim.restore(std::mem::replace(&mut st.sim, sim.state()))
+                    .map_err(|e| CfdDemError::Dem(DemError::Resume(e)))?;
+                flow.restore(st.flow.clone())?;
+                if st.injectors.len() != injectors.len() {
+                    return Err(CfdDemError::Dem(DemError::Resume("the number of injectors changed".into())));
+                }
+                for (slot, state) in injectors.iter_mut().zip(&st.injectors) {
+                    slot.0.state = state.clone();
+                }
+                let series =
+                    CsvSeries::resume(&series_path, &SERIES, st.series_bytes).map_err(io_at(&series_path))?;
+                let probes =
+                    CsvSeries::resume(&probes_path, &pcols, st.probes_bytes).map_err(io_at(&probes_path))?;
+                let t = st.flow.t;
+                let mut fields = PvdSeries::load_or_new(&fields_pvd).map_err(io_at(&fields_pvd))?;
+                fields.truncate_after(t).map_err(io_at(&fields_pvd))?;
+                let mut particles = PvdSeries::load_or_new(&particles_pvd).map_err(io_at(&particles_pvd))?;
+                particles.truncate_after(t).map_err(io_at(&particles_pvd))?;
+                let trajectories = trajectory_series(dem_cfg, dir, Some(st.trajectories_bytes))?;
+                let meshes = mesh_series(&sim, dir, Some(t))?;
+                tracing::info!("resumed at t = {t:.6} s, coupling step {}", st.coupling_steps);
+                (st, series, probes, fields, particles, trajectories, meshes)
             }
-            for (slot, state) in injectors.iter_mut().zip(&st.injectors) {
-                slot.0.state = state.clone();
-            }
-            let series =
-                CsvSeries::resume(&series_path, &SERIES, st.series_bytes).map_err(io_at(&series_path))?;
-            let probes =
-                CsvSeries::resume(&probes_path, &pcols, st.probes_bytes).map_err(io_at(&probes_path))?;
-            let t = st.flow.t;
-            let mut fields = PvdSeries::load_or_new(&fields_pvd).map_err(io_at(&fields_pvd))?;
-            fields.truncate_after(t).map_err(io_at(&fields_pvd))?;
-            let mut particles = PvdSeries::load_or_new(&particles_pvd).map_err(io_at(&particles_pvd))?;
-            particles.truncate_after(t).map_err(io_at(&particles_pvd))?;
-            let trajectories = trajectory_series(dem_cfg, dir, Some(st.trajectories_bytes))?;
-            let meshes = mesh_series(&sim, dir, Some(t))?;
-            tracing::info!("resumed at t = {t:.6} s, coupling step {}", st.coupling_steps);
-            (st, series, probes, fields, particles, trajectories, meshes)
-        }
-        None => {
-            let initial = setup::initial_particles(dem_cfg, &sim.walls, sim.templates())?;
-            for p in initial.spheres {
-                sim.add_particle(p);
-            }
-            for (template, material, body) in initial.bodies {
-                sim.add_clump(template, material, body)?;
-            }
-            let warnings = time_step_warnings(dem_cfg, &sim);
-            for w in &warnings {
-                tracing::warn!("{w}");
-            }
-            let l = flow.grid.layout;
-            tracing::info!(
+            None => {
+                let initial = setup::initial_particles(dem_cfg, &sim.walls, sim.templates())?;
+                for p in initial.spheres {
+                    sim.add_particle(p);
+                }
+                for (template, material, body) in initial.bodies {
+                    sim.add_clump(template, material, body)?;
+                }
+                let warnings = time_step_warnings(dem_cfg, &sim);
+                for w in &warnings {
+                    tracing::warn!("{w}");
+                }
+                let l = flow.grid.layout;
+                tracing::info!(
                 "cfd_dem {}: grid {} × {} × {}, ρ_f = {} kg/m³, ν = {:.4e} m²/s; {} spheres; DEM step {:e} s, \
                  {} DEM steps per fluid step; drag {:?}, model {:?}, void fraction {:?}; {} thread(s)",
                 cfg.title,
@@ -368,35 +369,43 @@ fn drive<L: ContactLaw>(
                 cfg.coupling.void_fraction,
                 rayon::current_num_threads()
             );
-            let st = RunState {
-                sim: sim.state(),
-                flow: flow.state.clone(),
-                injectors: Vec::new(),
-                next_field: 0.0,
-                field_count: 0,
-                next_sample: 0.0,
-                series_bytes: 0,
-                probes_bytes: 0,
-                coupling_steps: 0,
-                max_mismatch: 0.0,
-                last: Default::default(),
-                last_courant: 0.0,
-                last_iterations: 0,
-                max_courant: 0.0,
-                pressure_iterations: 0,
-                times: CouplingTimes::default(),
-                wall_seconds: 0.0,
-                warnings,
-                events: EventLog::default(),
-                trajectories_bytes: 0,
-            };
-            let series = CsvSeries::create(&series_path, &SERIES).map_err(io_at(&series_path))?;
-            let probes = CsvSeries::create(&probes_path, &pcols).map_err(io_at(&probes_path))?;
-            let trajectories = trajectory_series(dem_cfg, dir, None)?;
-            let meshes = mesh_series(&sim, dir, None)?;
-            (st, series, probes, PvdSeries::new(&fields_pvd), PvdSeries::new(&particles_pvd), trajectories, meshes)
-        }
-    };
+                let st = RunState {
+                    sim: sim.state(),
+                    flow: flow.state.clone(),
+                    injectors: Vec::new(),
+                    next_field: 0.0,
+                    field_count: 0,
+                    next_sample: 0.0,
+                    series_bytes: 0,
+                    probes_bytes: 0,
+                    coupling_steps: 0,
+                    max_mismatch: 0.0,
+                    last: Default::default(),
+                    last_courant: 0.0,
+                    last_iterations: 0,
+                    max_courant: 0.0,
+                    pressure_iterations: 0,
+                    times: CouplingTimes::default(),
+                    wall_seconds: 0.0,
+                    warnings,
+                    events: EventLog::default(),
+                    trajectories_bytes: 0,
+                };
+                let series = CsvSeries::create(&series_path, &SERIES).map_err(io_at(&series_path))?;
+                let probes = CsvSeries::create(&probes_path, &pcols).map_err(io_at(&probes_path))?;
+                let trajectories = trajectory_series(dem_cfg, dir, None)?;
+                let meshes = mesh_series(&sim, dir, None)?;
+                (
+                    st,
+                    series,
+                    probes,
+                    PvdSeries::new(&fields_pvd),
+                    PvdSeries::new(&particles_pvd),
+                    trajectories,
+                    meshes,
+                )
+            }
+        };
     let mut c = Coupled::new(flow, sim, cfg.coupling)?;
     c.times = st.times;
     // The void fraction and the exchanged forces of the current state, for the first outputs (a
@@ -506,8 +515,9 @@ fn drive<L: ContactLaw>(
             }
         }
         let events = &mut st.events;
-        let (rep, frep) =
-            c.step_observed(|dem| record_step(dem_cfg, dem, events, trajectories.as_mut()).map_err(CfdDemError::Dem))?;
+        let (rep, frep) = c.step_observed(|dem| {
+            record_step(dem_cfg, dem, events, trajectories.as_mut()).map_err(CfdDemError::Dem)
+        })?;
         st.coupling_steps += 1;
         st.last = rep;
         st.max_mismatch = st.max_mismatch.max(rep.relative_mismatch);

@@ -476,7 +476,8 @@ fn a_cfd_dem_run_writes_the_dem_event_log_trajectories_and_mesh_snapshots_and_re
     use spatter_io::run::{RunContext, RunDir};
     let tmp = tempfile::tempdir().unwrap();
     let stl = tmp.path().join("distributor.stl");
-    std::fs::write(&stl, spatter_core::mesh::TriMesh::rectangle(0.024, 0.024, 0.0, 2, 2).to_binary_stl()).unwrap();
+    std::fs::write(&stl, spatter_core::mesh::TriMesh::rectangle(0.024, 0.024, 0.0, 2, 2).to_binary_stl())
+        .unwrap();
     let cfg: CfdDemConfig = toml::from_str(&falling_beads_toml(&stl)).unwrap_or_else(|e| panic!("{e}"));
     let full = RunDir::create(&tmp.path().join("full")).unwrap();
     let s = run(&cfg, &RunContext::new(&full, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));

@@ -12,8 +12,8 @@ pub mod setup;
 
 pub use config::*;
 pub(crate) use run::{
-    inject, mesh_artifacts, mesh_series, record_step, summarize_records, time_step_warnings, trajectory_series,
-    write_events, write_mesh_snapshots,
+    inject, mesh_artifacts, mesh_series, record_step, summarize_records, time_step_warnings,
+    trajectory_series, write_events, write_mesh_snapshots,
 };
 pub use run::{
     run, run_collect, run_collect_partnered, run_collect_with, simulation, with_law, MeshWallResult,

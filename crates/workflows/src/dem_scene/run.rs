@@ -587,7 +587,8 @@ pub(crate) fn mesh_series<L: ContactLaw>(
         let p = dir.path(&format!("{}_wall.pvd", sim.walls[w].name));
         meshes.push(Some(match resume {
             Some(t) => {
-                let mut s = PvdSeries::load_or_new(&p).map_err(|source| DemError::Io { path: p.clone(), source })?;
+                let mut s =
+                    PvdSeries::load_or_new(&p).map_err(|source| DemError::Io { path: p.clone(), source })?;
                 s.truncate_after(t).map_err(|source| DemError::Io { path: p.clone(), source })?;
                 s
             }
@@ -683,7 +684,8 @@ pub(crate) fn mesh_artifacts<L: ContactLaw>(
     }
     for w in (0..sim.walls.len()).filter(|&w| sim.is_mesh_wall(w)) {
         let name = &sim.walls[w].name;
-        s.artifacts.push((format!("wall {name} impacts (ParaView)"), ctx.dir.path(&format!("{name}_wall.pvd"))));
+        s.artifacts
+            .push((format!("wall {name} impacts (ParaView)"), ctx.dir.path(&format!("{name}_wall.pvd"))));
     }
 }
 
