@@ -469,11 +469,24 @@ impl<L: ContactLaw> Coupled<L> {
     pub fn step_reporting(
         &mut self,
     ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), CouplingError> {
+        self.step_observed(|_| Ok(()))
+    }
+
+    /// Like [`Coupled::step_reporting`], calling `after_dem_step` with the DEM after each of the N DEM
+    /// steps (the scene's event log and trajectories read it there). The steps are the same as without
+    /// the observer.
+    pub fn step_observed<E: From<CouplingError> + Send>(
+        &mut self,
+        mut after_dem_step: impl FnMut(&Simulation<L>) -> Result<(), E> + Send,
+    ) -> Result<(ExchangeReport, spatter_cfd::solver::StepReport), E> {
         in_pool(|| {
             let n = self.coupling.options.dem_steps_per_fluid_step;
             let out = self.coupling.exchange_and_advance(&mut self.dem, n)?;
             let t1 = Instant::now();
-            self.dem.run_steps(self.coupling.options.dem_steps_per_fluid_step as u64)?;
+            for _ in 0..n {
+                self.dem.step().map_err(CouplingError::from)?;
+                after_dem_step(&self.dem)?;
+            }
             self.coupling.times.dem += t1.elapsed().as_secs_f64();
             Ok(out)
         })

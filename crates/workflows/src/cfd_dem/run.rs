@@ -10,6 +10,9 @@
 //! * `series.csv` — every `output.sample_interval_s`: pressure drop, bed height, particle and fluid
 //!   momentum, the exchanged force and the momentum balance of the last coupling step;
 //! * `probes.csv` — fluid velocity and pressure at each probe, at the same times;
+//! * with the DEM scene's `[dem.output]`: `events.csv` and `trajectories.csv` (read after every DEM
+//!   step, through the `dem` kind's writers) and `<wall>_wall.pvd` + `walls/<wall>_NNNNN.vtu` for the
+//!   mesh walls at the field snapshots;
 //! * `speed.png`, `void_fraction.png` — the fluid speed and the void fraction on a planar cut at the end;
 //!   `pressure_drop.png` — the pressure drop and the bed height over time;
 //! * `log.txt`: set-up, a line per snapshot with the momentum balance, the time split at the end.
@@ -18,7 +21,11 @@ use super::config::CfdDemConfig;
 use super::{Coupled, CouplingError, CouplingTimes};
 use crate::cfd::run::{cut_png, io_at, max_speed};
 use crate::cfd::{build_domain, FlowDomain, FlowRunError};
-use crate::dem_scene::{inject, setup, time_step_warnings, with_law, WithLaw};
+use crate::dem_scene::events::EventLog;
+use crate::dem_scene::{
+    inject, mesh_artifacts, mesh_series, record_step, setup, summarize_records, time_step_warnings,
+    trajectory_series, with_law, write_events, write_mesh_snapshots, WithLaw,
+};
 use serde::{Deserialize, Serialize};
 use spatter_cfd::output::{probe, speed_slice, to_vtr};
 use spatter_cfd::Flow;
@@ -118,6 +125,10 @@ struct RunState<S> {
     times: CouplingTimes,
     wall_seconds: f64,
     warnings: Vec<String>,
+    /// The DEM scene's event log (empty without `[dem.output.events]`).
+    events: EventLog,
+    /// Bytes written to `trajectories.csv` (0 when not written).
+    trajectories_bytes: u64,
 }
 
 const SERIES: [&str; 20] = [
@@ -297,47 +308,51 @@ fn drive<L: ContactLaw>(
     let pcols: Vec<&str> = pcols.iter().map(String::as_str).collect();
     let dem_cfg = &cfg.dem;
     let mut sim = crate::dem_scene::simulation(law, built, dem_cfg);
+    sim.set_impact_recording(dem_cfg.output.events.is_some());
     let mut injectors = setup::injectors(dem_cfg, sim.templates())?;
     let resumed: Option<RunState<L::State>> =
         if ctx.resume && ckpt.exists() { Some(ctx.load_checkpoint()?) } else { None };
     let mut flow = flow;
-    let (mut st, mut series, mut probes, mut fields, mut particles) = match resumed {
-        Some(mut st) => {
-            sim.restore(std::mem::replace(&mut st.sim, sim.state()))
-                .map_err(|e| CfdDemError::Dem(DemError::Resume(e)))?;
-            flow.restore(st.flow.clone())?;
-            if st.injectors.len() != injectors.len() {
-                return Err(CfdDemError::Dem(DemError::Resume("the number of injectors changed".into())));
+    let (mut st, mut series, mut probes, mut fields, mut particles, mut trajectories, mut meshes) =
+        match resumed {
+            Some(mut st) => {
+                sim.restore(std::mem::replace(&mut st.sim, sim.state()))
+                    .map_err(|e| CfdDemError::Dem(DemError::Resume(e)))?;
+                flow.restore(st.flow.clone())?;
+                if st.injectors.len() != injectors.len() {
+                    return Err(CfdDemError::Dem(DemError::Resume("the number of injectors changed".into())));
+                }
+                for (slot, state) in injectors.iter_mut().zip(&st.injectors) {
+                    slot.0.state = state.clone();
+                }
+                let series =
+                    CsvSeries::resume(&series_path, &SERIES, st.series_bytes).map_err(io_at(&series_path))?;
+                let probes =
+                    CsvSeries::resume(&probes_path, &pcols, st.probes_bytes).map_err(io_at(&probes_path))?;
+                let t = st.flow.t;
+                let mut fields = PvdSeries::load_or_new(&fields_pvd).map_err(io_at(&fields_pvd))?;
+                fields.truncate_after(t).map_err(io_at(&fields_pvd))?;
+                let mut particles = PvdSeries::load_or_new(&particles_pvd).map_err(io_at(&particles_pvd))?;
+                particles.truncate_after(t).map_err(io_at(&particles_pvd))?;
+                let trajectories = trajectory_series(dem_cfg, dir, Some(st.trajectories_bytes))?;
+                let meshes = mesh_series(&sim, dir, Some(t))?;
+                tracing::info!("resumed at t = {t:.6} s, coupling step {}", st.coupling_steps);
+                (st, series, probes, fields, particles, trajectories, meshes)
             }
-            for (slot, state) in injectors.iter_mut().zip(&st.injectors) {
-                slot.0.state = state.clone();
-            }
-            let series =
-                CsvSeries::resume(&series_path, &SERIES, st.series_bytes).map_err(io_at(&series_path))?;
-            let probes =
-                CsvSeries::resume(&probes_path, &pcols, st.probes_bytes).map_err(io_at(&probes_path))?;
-            let t = st.flow.t;
-            let mut fields = PvdSeries::load_or_new(&fields_pvd).map_err(io_at(&fields_pvd))?;
-            fields.truncate_after(t).map_err(io_at(&fields_pvd))?;
-            let mut particles = PvdSeries::load_or_new(&particles_pvd).map_err(io_at(&particles_pvd))?;
-            particles.truncate_after(t).map_err(io_at(&particles_pvd))?;
-            tracing::info!("resumed at t = {t:.6} s, coupling step {}", st.coupling_steps);
-            (st, series, probes, fields, particles)
-        }
-        None => {
-            let initial = setup::initial_particles(dem_cfg, &sim.walls, sim.templates())?;
-            for p in initial.spheres {
-                sim.add_particle(p);
-            }
-            for (template, material, body) in initial.bodies {
-                sim.add_clump(template, material, body)?;
-            }
-            let warnings = time_step_warnings(dem_cfg, &sim);
-            for w in &warnings {
-                tracing::warn!("{w}");
-            }
-            let l = flow.grid.layout;
-            tracing::info!(
+            None => {
+                let initial = setup::initial_particles(dem_cfg, &sim.walls, sim.templates())?;
+                for p in initial.spheres {
+                    sim.add_particle(p);
+                }
+                for (template, material, body) in initial.bodies {
+                    sim.add_clump(template, material, body)?;
+                }
+                let warnings = time_step_warnings(dem_cfg, &sim);
+                for w in &warnings {
+                    tracing::warn!("{w}");
+                }
+                let l = flow.grid.layout;
+                tracing::info!(
                 "cfd_dem {}: grid {} × {} × {}, ρ_f = {} kg/m³, ν = {:.4e} m²/s; {} spheres; DEM step {:e} s, \
                  {} DEM steps per fluid step; drag {:?}, model {:?}, void fraction {:?}; {} thread(s)",
                 cfg.title,
@@ -354,31 +369,43 @@ fn drive<L: ContactLaw>(
                 cfg.coupling.void_fraction,
                 rayon::current_num_threads()
             );
-            let st = RunState {
-                sim: sim.state(),
-                flow: flow.state.clone(),
-                injectors: Vec::new(),
-                next_field: 0.0,
-                field_count: 0,
-                next_sample: 0.0,
-                series_bytes: 0,
-                probes_bytes: 0,
-                coupling_steps: 0,
-                max_mismatch: 0.0,
-                last: Default::default(),
-                last_courant: 0.0,
-                last_iterations: 0,
-                max_courant: 0.0,
-                pressure_iterations: 0,
-                times: CouplingTimes::default(),
-                wall_seconds: 0.0,
-                warnings,
-            };
-            let series = CsvSeries::create(&series_path, &SERIES).map_err(io_at(&series_path))?;
-            let probes = CsvSeries::create(&probes_path, &pcols).map_err(io_at(&probes_path))?;
-            (st, series, probes, PvdSeries::new(&fields_pvd), PvdSeries::new(&particles_pvd))
-        }
-    };
+                let st = RunState {
+                    sim: sim.state(),
+                    flow: flow.state.clone(),
+                    injectors: Vec::new(),
+                    next_field: 0.0,
+                    field_count: 0,
+                    next_sample: 0.0,
+                    series_bytes: 0,
+                    probes_bytes: 0,
+                    coupling_steps: 0,
+                    max_mismatch: 0.0,
+                    last: Default::default(),
+                    last_courant: 0.0,
+                    last_iterations: 0,
+                    max_courant: 0.0,
+                    pressure_iterations: 0,
+                    times: CouplingTimes::default(),
+                    wall_seconds: 0.0,
+                    warnings,
+                    events: EventLog::default(),
+                    trajectories_bytes: 0,
+                };
+                let series = CsvSeries::create(&series_path, &SERIES).map_err(io_at(&series_path))?;
+                let probes = CsvSeries::create(&probes_path, &pcols).map_err(io_at(&probes_path))?;
+                let trajectories = trajectory_series(dem_cfg, dir, None)?;
+                let meshes = mesh_series(&sim, dir, None)?;
+                (
+                    st,
+                    series,
+                    probes,
+                    PvdSeries::new(&fields_pvd),
+                    PvdSeries::new(&particles_pvd),
+                    trajectories,
+                    meshes,
+                )
+            }
+        };
     let mut c = Coupled::new(flow, sim, cfg.coupling)?;
     c.times = st.times;
     // The void fraction and the exchanged forces of the current state, for the first outputs (a
@@ -430,6 +457,9 @@ fn drive<L: ContactLaw>(
         }
         if t >= st.next_field - eps || done {
             write_snapshot(ctx, &mut fields, &mut particles, &c, st.field_count)?;
+            if dem_cfg.output.mesh_vtu {
+                write_mesh_snapshots(&c.dem, ctx, &mut meshes, u64::from(st.field_count))?;
+            }
             st.field_count += 1;
             tracing::info!(
                 "t = {t:.6} s, coupling step {}: {} spheres, pressure drop {:.4e} Pa, bed height {:.4e} m, \
@@ -455,6 +485,10 @@ fn drive<L: ContactLaw>(
             probes.flush().map_err(io_at(&probes_path))?;
             st.series_bytes = series.bytes_written();
             st.probes_bytes = probes.bytes_written();
+            if let Some(tr) = trajectories.as_mut() {
+                tr.flush().map_err(io_at(&dir.path("trajectories.csv")))?;
+                st.trajectories_bytes = tr.bytes_written();
+            }
             st.flow = c.flow.state.clone();
             st.sim = c.dem.state();
             st.injectors = injectors.iter().map(|(i, _)| i.state.clone()).collect();
@@ -463,6 +497,7 @@ fn drive<L: ContactLaw>(
             st.wall_seconds += session.elapsed().as_secs_f64();
             ctx.save_checkpoint(&st)?;
             st.wall_seconds = wall_before;
+            write_events(dem_cfg, &c.dem, &st.events, ctx)?;
         }
         if stop {
             tracing::info!(
@@ -479,7 +514,10 @@ fn drive<L: ContactLaw>(
                 inject(&mut c.dem, inj, region, k);
             }
         }
-        let (rep, frep) = c.step_reporting()?;
+        let events = &mut st.events;
+        let (rep, frep) = c.step_observed(|dem| {
+            record_step(dem_cfg, dem, events, trajectories.as_mut()).map_err(CfdDemError::Dem)
+        })?;
         st.coupling_steps += 1;
         st.last = rep;
         st.max_mismatch = st.max_mismatch.max(rep.relative_mismatch);
@@ -491,6 +529,10 @@ fn drive<L: ContactLaw>(
     }
     series.flush().map_err(io_at(&series_path))?;
     probes.flush().map_err(io_at(&probes_path))?;
+    if let Some(tr) = trajectories.as_mut() {
+        tr.flush().map_err(io_at(&dir.path("trajectories.csv")))?;
+    }
+    write_events(dem_cfg, &c.dem, &st.events, ctx)?;
     if ckpt.exists() {
         let _ = std::fs::remove_file(&ckpt);
     }
@@ -614,6 +656,8 @@ fn finish<L: ContactLaw>(
     s.artifacts.push(("fluid fields (ParaView)".into(), dir.path("fields.pvd")));
     s.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
     s.artifacts.push(("series".into(), series_path));
+    summarize_records(&cfg.dem, &st.events, ctx, &mut s);
+    mesh_artifacts(&cfg.dem, &c.dem, ctx, &mut s);
     let dp = pressure_drop(flow, c.dem.gravity, st.last.to_boundaries);
     let h = bed_height(&c.dem, flow);
     let (pm, ke) = particle_momentum(&c.dem);

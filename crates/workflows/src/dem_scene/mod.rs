@@ -11,7 +11,10 @@ mod run;
 pub mod setup;
 
 pub use config::*;
-pub(crate) use run::{inject, time_step_warnings};
+pub(crate) use run::{
+    inject, mesh_artifacts, mesh_series, record_step, summarize_records, time_step_warnings,
+    trajectory_series, write_events, write_mesh_snapshots,
+};
 pub use run::{
     run, run_collect, run_collect_partnered, run_collect_with, simulation, with_law, MeshWallResult,
     SceneResults, StepPartner, WithLaw,

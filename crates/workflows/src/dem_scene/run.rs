@@ -565,16 +565,127 @@ impl OutputFiles {
             self.particles.push(t, rel).map_err(io(&ctx.dir.path("particles.pvd")))?;
         }
         if cfg.output.mesh_vtu {
-            for (w, series) in self.meshes.iter_mut().enumerate() {
-                if let Some(series) = series {
-                    let rel = format!("walls/{}_{index:05}.vtu", sim.walls[w].name);
-                    let path = ctx.dir.path(&rel);
-                    write_mesh(sim, w, &path).map_err(io(&path))?;
-                    series.push(t, &rel).map_err(io(&path))?;
-                }
-            }
+            write_mesh_snapshots(sim, ctx, &mut self.meshes, index)?;
         }
         Ok(())
+    }
+}
+
+/// The `<name>_wall.pvd` series of every mesh wall (`None` for the analytic walls); on resume at time `t`
+/// \[s\] loaded and cut after `t`.
+pub(crate) fn mesh_series<L: ContactLaw>(
+    sim: &Simulation<L>,
+    dir: &spatter_io::run::RunDir,
+    resume: Option<f64>,
+) -> Result<Vec<Option<PvdSeries>>, DemError> {
+    let mut meshes = Vec::new();
+    for w in 0..sim.walls.len() {
+        if !sim.is_mesh_wall(w) {
+            meshes.push(None);
+            continue;
+        }
+        let p = dir.path(&format!("{}_wall.pvd", sim.walls[w].name));
+        meshes.push(Some(match resume {
+            Some(t) => {
+                let mut s =
+                    PvdSeries::load_or_new(&p).map_err(|source| DemError::Io { path: p.clone(), source })?;
+                s.truncate_after(t).map_err(|source| DemError::Io { path: p.clone(), source })?;
+                s
+            }
+            None => PvdSeries::new(&p),
+        }));
+    }
+    Ok(meshes)
+}
+
+/// Snapshot number `index` of every mesh wall: `walls/<name>_NNNNN.vtu` in its pose at the current time
+/// with its per-triangle impact records, added to the wall's series at the current time.
+pub(crate) fn write_mesh_snapshots<L: ContactLaw>(
+    sim: &Simulation<L>,
+    ctx: &RunContext,
+    meshes: &mut [Option<PvdSeries>],
+    index: u64,
+) -> Result<(), DemError> {
+    let t = sim.time();
+    for (w, series) in meshes.iter_mut().enumerate() {
+        if let Some(series) = series {
+            let rel = format!("walls/{}_{index:05}.vtu", sim.walls[w].name);
+            let path = ctx.dir.path(&rel);
+            let io = |source| DemError::Io { path: path.clone(), source };
+            write_mesh(sim, w, &path).map_err(io)?;
+            series.push(t, &rel).map_err(io)?;
+        }
+    }
+    Ok(())
+}
+
+/// After a step: the wall impacts and plane crossings into the event log (with `[output.events]`), and
+/// the followed objects' rows into `trajectories` every `every_steps` steps (with
+/// `[output.trajectories]`; `None` on the ranks that write no files).
+pub(crate) fn record_step<L: ContactLaw>(
+    cfg: &SceneConfig,
+    sim: &Simulation<L>,
+    events: &mut EventLog,
+    trajectories: Option<&mut CsvSeries>,
+) -> Result<(), DemError> {
+    if let Some(e) = &cfg.output.events {
+        events.after_step(sim, e);
+    }
+    if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, trajectories) {
+        if sim.step_count() % tc.every_steps == 0 {
+            for row in trajectory_rows(sim, tc) {
+                tr.row(&row).map_err(|source| DemError::Io { path: tr.path().to_owned(), source })?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Opens `trajectories.csv` with `[output.trajectories]` (on resume cut to the `bytes` a checkpoint
+/// recorded); `None` without it.
+pub(crate) fn trajectory_series(
+    cfg: &SceneConfig,
+    dir: &spatter_io::run::RunDir,
+    resume: Option<u64>,
+) -> Result<Option<CsvSeries>, DemError> {
+    if cfg.output.trajectories.is_none() {
+        return Ok(None);
+    }
+    let columns: Vec<String> = TRAJECTORY_COLUMNS.iter().map(|c| c.to_string()).collect();
+    series(&dir.path("trajectories.csv"), &columns, resume).map(Some)
+}
+
+/// The summary's part of the event log and the trajectories: the counts of objects that hit a wall and
+/// crossed the plane, and the two files as artifacts.
+pub(crate) fn summarize_records(cfg: &SceneConfig, events: &EventLog, ctx: &RunContext, s: &mut RunSummary) {
+    if let Some(e) = &cfg.output.events {
+        let (hit, crossed) = events.counts();
+        s.scalar("objects_hit_wall", hit as f64);
+        s.headline.push(format!("events: {hit} bodies/spheres hit a wall, {crossed} crossed the plane"));
+        if e.crossing_plane.is_some() {
+            s.scalar("objects_crossed_plane", crossed as f64);
+        }
+        s.artifacts.push(("impact and crossing events".into(), ctx.dir.path("events.csv")));
+    }
+    if cfg.output.trajectories.is_some() {
+        s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
+    }
+}
+
+/// The `<name>_wall.pvd` series of the mesh walls as artifacts (with `output.mesh_vtu`).
+pub(crate) fn mesh_artifacts<L: ContactLaw>(
+    cfg: &SceneConfig,
+    sim: &Simulation<L>,
+    ctx: &RunContext,
+    s: &mut RunSummary,
+) {
+    if !cfg.output.mesh_vtu {
+        return;
+    }
+    for w in (0..sim.walls.len()).filter(|&w| sim.is_mesh_wall(w)) {
+        let name = &sim.walls[w].name;
+        s.artifacts
+            .push((format!("wall {name} impacts (ParaView)"), ctx.dir.path(&format!("{name}_wall.pvd"))));
     }
 }
 
@@ -684,7 +795,6 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     let dir = ctx.dir;
     let csv_path = dir.path("energy.csv");
     let pvd_path = dir.path("particles.pvd");
-    let mesh_pvd = |name: &str| dir.path(&format!("{name}_wall.pvd"));
     let io = |p: &std::path::Path| {
         let p = p.to_owned();
         move |source| DemError::Io { path: p, source }
@@ -694,8 +804,6 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     let bodies_path = dir.path("bodies.csv");
     let wear_path = dir.path("wear.csv");
     let body_columns: Vec<String> = BODY_COLUMNS.iter().map(|c| c.to_string()).collect();
-    let trajectories_path = dir.path("trajectories.csv");
-    let trajectory_columns: Vec<String> = TRAJECTORY_COLUMNS.iter().map(|c| c.to_string()).collect();
     sim.set_impact_recording(cfg.output.events.is_some());
     let mut events = EventLog::default();
     let warnings: Vec<String>;
@@ -721,17 +829,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         let files = if root {
             let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
             particles.truncate_after(t).map_err(io(&pvd_path))?;
-            let mut meshes = Vec::new();
-            for w in 0..sim.walls.len() {
-                meshes.push(if sim.is_mesh_wall(w) {
-                    let p = mesh_pvd(&sim.walls[w].name);
-                    let mut s = PvdSeries::load_or_new(&p).map_err(io(&p))?;
-                    s.truncate_after(t).map_err(io(&p))?;
-                    Some(s)
-                } else {
-                    None
-                });
-            }
+            let meshes = mesh_series(&sim, dir, Some(t))?;
             Some(OutputFiles {
                 csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
                 particles,
@@ -744,14 +842,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                     true => Some(series(&wear_path, &wear_columns(&sim), Some(ck.wear_csv_bytes))?),
                     false => None,
                 },
-                trajectories: match cfg.output.trajectories {
-                    Some(_) => Some(series(
-                        &trajectories_path,
-                        &trajectory_columns,
-                        Some(ck.trajectories_csv_bytes),
-                    )?),
-                    None => None,
-                },
+                trajectories: trajectory_series(cfg, dir, Some(ck.trajectories_csv_bytes))?,
             })
         } else {
             None
@@ -795,9 +886,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             sim.decompose_over(comm, &split_points(cfg, &sim))?;
         }
         let files = if root {
-            let meshes = (0..sim.walls.len())
-                .map(|w| sim.is_mesh_wall(w).then(|| PvdSeries::new(&mesh_pvd(&sim.walls[w].name))))
-                .collect();
+            let meshes = mesh_series(&sim, dir, None)?;
             Some(OutputFiles {
                 csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
                 particles: PvdSeries::new(&pvd_path),
@@ -810,10 +899,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
                     true => Some(series(&wear_path, &wear_columns(&sim), None)?),
                     false => None,
                 },
-                trajectories: match cfg.output.trajectories {
-                    Some(_) => Some(series(&trajectories_path, &trajectory_columns, None)?),
-                    None => None,
-                },
+                trajectories: trajectory_series(cfg, dir, None)?,
             })
         } else {
             None
@@ -884,17 +970,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         if let (Some(p), Some(st)) = (&cfg.probe, probe.as_mut()) {
             super::probe::after_step(p, &sim, st, probe_every);
         }
-        if let Some(e) = &cfg.output.events {
-            events.after_step(&sim, e);
-        }
-        let trajectories = out.files.as_mut().and_then(|f| f.trajectories.as_mut());
-        if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, trajectories) {
-            if sim.step_count() % tc.every_steps == 0 {
-                for row in trajectory_rows(&sim, tc) {
-                    tr.row(&row).map_err(io(tr.path()))?;
-                }
-            }
-        }
+        record_step(cfg, &sim, &mut events, out.files.as_mut().and_then(|f| f.trajectories.as_mut()))?;
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps || probe_ends {
             out.write(cfg, &mut sim, ctx)?;
             partner.output(&sim, ctx)?;
@@ -936,18 +1012,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     if let (Some(p), Some(st)) = (&cfg.probe, &probe) {
         super::probe::finish(p, st, ctx, &mut s)?;
     }
-    if cfg.output.events.is_some() {
-        let (hit, crossed) = events.counts();
-        s.scalar("objects_hit_wall", hit as f64);
-        s.headline.push(format!("events: {hit} bodies/spheres hit a wall, {crossed} crossed the plane"));
-        if cfg.output.events.as_ref().is_some_and(|e| e.crossing_plane.is_some()) {
-            s.scalar("objects_crossed_plane", crossed as f64);
-        }
-        s.artifacts.push(("impact and crossing events".into(), ctx.dir.path("events.csv")));
-    }
-    if cfg.output.trajectories.is_some() {
-        s.artifacts.push(("trajectories".into(), ctx.dir.path("trajectories.csv")));
-    }
+    summarize_records(cfg, &events, ctx, &mut s);
     let maps = if root { write_wear_maps(&sim, ctx)? } else { Vec::new() };
     for (name, png, record) in maps {
         s.artifacts.push((format!("eroded mass map {name}"), png));
@@ -962,7 +1027,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
 
 /// Writes `events.csv` (the whole log so far; rewritten at every checkpoint and at the end) when the
 /// scene keeps an event log.
-fn write_events<L: ContactLaw>(
+pub(crate) fn write_events<L: ContactLaw>(
     cfg: &SceneConfig,
     sim: &Simulation<L>,
     log: &EventLog,
@@ -1306,16 +1371,6 @@ fn summary<L: ContactLaw>(
     if cfg.output.particles_vtu {
         s.artifacts.push(("particles (ParaView)".into(), ctx.dir.path("particles.pvd")));
     }
-    if cfg.output.mesh_vtu {
-        for w in 0..sim.walls.len() {
-            if sim.is_mesh_wall(w) {
-                let name = &sim.walls[w].name;
-                s.artifacts.push((
-                    format!("wall {name} impacts (ParaView)"),
-                    ctx.dir.path(&format!("{name}_wall.pvd")),
-                ));
-            }
-        }
-    }
+    mesh_artifacts(cfg, sim, ctx, &mut s);
     s
 }
