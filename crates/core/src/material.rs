@@ -114,6 +114,15 @@ pub fn effective_mass(m1: f64, m2: f64) -> f64 {
     harmonic_pair(m1, m2)
 }
 
+/// Damping ratio ξ = −ln e/√(ln²e + π²) ∈ \[0, 1) of the linear spring–dashpot contact that realises the
+/// coefficient of restitution `e` ∈ (0, 1] (0 at e = 1, → 1 as e → 0). Its negative is the damping
+/// parameter β of Tsuji, Tanaka & Ishida (1992) and Antypov & Elliott (2011, EPL 94:50004), which the
+/// Hertzian dashpots of LIGGGHTS and LAMMPS use.
+pub fn restitution_damping_ratio(e: f64) -> f64 {
+    let l = e.ln();
+    -l / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+}
+
 fn harmonic_pair(a: f64, b: f64) -> f64 {
     if a.is_infinite() {
         b
@@ -127,6 +136,20 @@ fn harmonic_pair(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn damping_ratio_of_restitution_matches_the_closed_form_and_inverts() {
+        // Values of β = ln e/√(ln²e + π²) (Tsuji, Tanaka & Ishida 1992), evaluated to six digits
+        // independently of this code; ξ = −β.
+        for (e, xi) in [(0.3, 0.357857), (0.5, 0.215454), (0.7, 0.112808), (0.9, 0.033518)] {
+            let got = restitution_damping_ratio(e);
+            assert!((got - xi).abs() < 1e-6, "ξ({e}) = {got}, expected {xi}");
+            // The linear oscillator's restitution e = exp(−πξ/√(1 − ξ²)) gives e back.
+            let back = (-std::f64::consts::PI * got / (1.0 - got * got).sqrt()).exp();
+            assert!((back - e).abs() < 1e-12, "e({got}) = {back}, expected {e}");
+        }
+        assert_eq!(restitution_damping_ratio(1.0), 0.0);
+    }
 
     #[test]
     fn snow_seed_effective_moduli() {

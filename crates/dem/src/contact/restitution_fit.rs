@@ -129,8 +129,7 @@ fn hermite_root(u0: f64, u1: f64, d0: f64, d1: f64) -> f64 {
 /// Ishida 1992; Antypov & Elliott 2011, EPL 94:50004): −β is the damping ratio of the linear
 /// spring–dashpot that realises e.
 pub fn beta(e: f64) -> f64 {
-    let l = e.ln();
-    l / (l * l + std::f64::consts::PI.powi(2)).sqrt()
+    -spatter_core::material::restitution_damping_ratio(e)
 }
 
 /// The closed-form ("linearised") coefficient used by LIGGGHTS and LAMMPS: c = 2|β| (p = 1) or

@@ -70,9 +70,7 @@ const R_STAR: f64 = 3.5;
 const SIN_TRANS: f64 = 0.5;
 
 /// Damping ratio ξ = −ln e / √(π² + ln² e) of a linear spring–dashpot with restitution e.
-pub fn damping_ratio(e: f64) -> f64 {
-    -crate::contact::restitution_fit::beta(e)
-}
+pub use spatter_core::material::restitution_damping_ratio as damping_ratio;
 
 /// Largest overlap of a linear spring–dashpot impact, Jasion Eq. B.6 (after Tuley et al. 2010):
 /// δ̂ = A u₀ / (ω_d √(1 + A²)) · exp(−arctan(A)/A), A = ω_d/(ξ ω_n) \[m\].

@@ -45,10 +45,7 @@ pub fn surface_energy_from_pull_off(theory: PullOffTheory, force: f64, r: f64) -
 
 /// Damping ratio ξ = −ln e/√(π² + ln²e) of the linear spring–dashpot contact with restitution `e` ∈ (0, 1]
 /// (0 at e = 1, → 1 as e → 0).
-pub fn damping_ratio(e: f64) -> f64 {
-    let l = e.ln();
-    -l / (PI * PI + l * l).sqrt()
-}
+pub use spatter_core::material::restitution_damping_ratio as damping_ratio;
 
 /// Dashpot coefficient |c| = 2ξ√(k m_eff) \[N s/m\] that gives restitution `e` to a linear contact of
 /// stiffness `k` \[N/m\] between bodies of effective mass `m_eff` \[kg\] (Jasion eq. 3.64–3.65).
