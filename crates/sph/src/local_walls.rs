@@ -43,6 +43,17 @@ pub(crate) struct LocalWalls {
     built_for: usize,
 }
 
+impl Chunk {
+    /// Whether the chunk's box, carried by its part's current frame, lies within `reach` \[m\] of
+    /// `region`.
+    fn within(&self, b: &Boundary, region: &Aabb, reach: f64) -> bool {
+        let f = &b.frames[self.part as usize];
+        let centre = f.to_world(self.centre);
+        let half = f.rot.abs() * self.half;
+        Aabb::new(centre - half, centre + half).gap(region) <= reach
+    }
+}
+
 /// Euclidean distance from `x` to the box `b` (0 inside; infinite faces never add) \[m\].
 pub(crate) fn point_gap(x: Vec3, b: &Aabb) -> f64 {
     Aabb::new(x, x).gap(b)
@@ -70,6 +81,40 @@ impl LocalWalls {
         self.built_for = b.len();
     }
 
+    fn ensure_built(&mut self, b: &Boundary) {
+        if self.built_for != b.len() || (self.chunks.is_empty() && !b.is_empty()) {
+            self.build(b);
+        }
+    }
+
+    /// Calls `f(i, x)` for every wall particle `i` of `b` whose current world position `x` lies within
+    /// `radius` \[m\] of `centre` (|x − centre| ≤ radius), in increasing index order. Chunks whose boxes
+    /// are farther away are skipped whole, so a query costs one box test per chunk and a distance per
+    /// particle of the nearby chunks instead of a distance per wall particle (a wall-pressure sensor on
+    /// several ranks looks for the wall particles outside its rank's wall set this way).
+    pub(crate) fn for_each_within(
+        &mut self,
+        b: &Boundary,
+        centre: Vec3,
+        radius: f64,
+        mut f: impl FnMut(usize, Vec3),
+    ) {
+        self.ensure_built(b);
+        let point = Aabb::new(centre, centre);
+        // The chunk test compares boxes whose corners are rounded differently from the particles'
+        // positions; a slack of 10⁻⁹ of the scale keeps a particle at exactly `radius` from being lost
+        // with its chunk (a chunk too many only costs its distance tests).
+        let reach = radius + 1e-9 * (1.0 + radius + centre.abs().max_element());
+        for c in self.chunks.iter().filter(|c| c.within(b, &point, reach)) {
+            for i in c.start as usize..c.end as usize {
+                let x = b.position(i);
+                if (x - centre).length() <= radius {
+                    f(i, x);
+                }
+            }
+        }
+    }
+
     /// Appends to `src` and `pos` the index and current world position of every wall particle of `b`
     /// within `reach` \[m\] of `region`, in increasing index order.
     pub(crate) fn select(
@@ -80,15 +125,12 @@ impl LocalWalls {
         src: &mut Vec<u32>,
         pos: &mut Vec<Vec3>,
     ) {
-        if self.built_for != b.len() || (self.chunks.is_empty() && !b.is_empty()) {
-            self.build(b);
-        }
-        self.near.par_iter_mut().zip(self.chunks.par_iter()).with_min_len(256).for_each(|(near, c)| {
-            let f = &b.frames[c.part as usize];
-            let centre = f.to_world(c.centre);
-            let half = f.rot.abs() * c.half;
-            *near = Aabb::new(centre - half, centre + half).gap(region) <= reach;
-        });
+        self.ensure_built(b);
+        self.near
+            .par_iter_mut()
+            .zip(self.chunks.par_iter())
+            .with_min_len(256)
+            .for_each(|(near, c)| *near = c.within(b, region, reach));
         for (c, _) in self.chunks.iter().zip(&self.near).filter(|(_, &near)| near) {
             for i in c.start as usize..c.end as usize {
                 let x = b.position(i);
@@ -153,6 +195,28 @@ mod tests {
                 assert!(pos.iter().zip(&src).all(|(x, &i)| *x == boundary.position(i as usize)));
             }
         }
+        // Spheres around points inside, on and outside the walls, both frames: the same particles in the
+        // same order as the distance test over every wall particle.
+        for boundary in [&sim.boundary, &b] {
+            for (centre, radius) in [
+                (Vec3::new(0.5, 0.2, 0.0), 0.07),
+                (Vec3::new(0.0, 0.0, 0.0), 0.15),
+                (Vec3::new(0.9, 0.35, 0.25), 0.05),
+                (Vec3::new(3.0, 3.0, 3.0), 0.1),
+            ] {
+                let mut lw = LocalWalls::default();
+                let mut got = Vec::new();
+                lw.for_each_within(boundary, centre, radius, |i, x| got.push((i, x)));
+                let want: Vec<(usize, Vec3)> = (0..boundary.len())
+                    .map(|i| (i, boundary.position(i)))
+                    .filter(|(_, x)| (*x - centre).length() <= radius)
+                    .collect();
+                assert_eq!(got, want, "sphere at {centre:?}, radius {radius}");
+            }
+        }
+        let mut n = 0;
+        LocalWalls::default().for_each_within(&sim.boundary, Vec3::new(0.5, 0.2, 0.0), 0.07, |_, _| n += 1);
+        assert!(n > 10 && n < sim.boundary.len() / 10, "{n} of {}", sim.boundary.len());
         // The cases test something: the first region selects some walls but not all, the third none.
         let mut lw = LocalWalls::default();
         let (mut src, mut pos) = (Vec::new(), Vec::new());

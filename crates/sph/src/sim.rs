@@ -1330,16 +1330,12 @@ impl Simulation {
             read.sort_unstable();
             let dry = eos.pressure(self.params.rest_density);
             let b = &self.boundary;
-            for i in 0..b.len() {
-                if b.area[i] <= 0.0 || read.binary_search(&(i as u32)).is_ok() {
-                    continue;
-                }
-                let p = b.position(i);
-                if (p - x).length() <= radius && d.owns(p) {
+            self.work.w_local.for_each_within(b, x, radius, |i, p| {
+                if b.area[i] > 0.0 && read.binary_search(&(i as u32)).is_err() && d.owns(p) {
                     s += dry;
                     n += 1;
                 }
-            }
+            });
         }
         (s, n)
     }
