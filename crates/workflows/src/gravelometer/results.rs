@@ -26,6 +26,23 @@ fn gap(x: f64) -> String {
     }
 }
 
+/// The headline of the impact statistics: mean ± SD (min–max) of speed and angle, without the undefined
+/// parts (no SD of one impact, nothing but a sentence when no stone reached the panel).
+pub(crate) fn impact_headline(speed: &Statistics, angle: &Statistics) -> String {
+    match speed.n {
+        0 => "no stone reached the panel: no impact statistics (lengthen duration_s)".to_string(),
+        1 => format!(
+            "first stone on the panel: speed {:.2} m/s, impact angle {:.1}°",
+            speed.mean, angle.mean
+        ),
+        n => format!(
+            "first {n} stones on the panel: speed {:.2} ± {:.2} m/s ({:.2}–{:.2}), impact angle {:.1} ± {:.1}° \
+             ({:.1}–{:.1}°)",
+            speed.mean, speed.sd, speed.min, speed.max, angle.mean, angle.sd, angle.min, angle.max
+        ),
+    }
+}
+
 /// Label of the strip-share curve a run records (a study overlays it across cases).
 pub const STRIP_SHARE_CURVE: &str = "share of the eroded mass per strip";
 /// Label of the strip-share table a run records (a study shows it with a column per case).
@@ -445,11 +462,7 @@ pub fn report(
     summary.artifacts.push((format!("impact statistics of the first {n} stones on the panel"), path));
     let speed = Statistics::of(&quantities[0].2);
     let angle = Statistics::of(&quantities[1].2);
-    summary.headline.push(format!(
-        "first {} stones on the panel: speed {:.2} ± {:.2} m/s ({:.2}–{:.2}), impact angle {:.1} ± {:.1}° \
-         ({:.1}–{:.1}°)",
-        speed.n, speed.mean, speed.sd, speed.min, speed.max, angle.mean, angle.sd, angle.min, angle.max
-    ));
+    summary.headline.push(impact_headline(&speed, &angle));
     for (k, (name, _, v)) in quantities.iter().take(2).enumerate() {
         let (labels, counts) = histogram(v, 8, 1);
         let png = dir.path(&format!("{name}_histogram.png"));

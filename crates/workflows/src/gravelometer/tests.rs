@@ -662,3 +662,24 @@ fn the_coupled_air_is_bit_identical_on_one_and_two_threads() {
         assert!(a == b, "{} differs between 1 and 2 threads", f.display());
     }
 }
+
+#[test]
+fn the_impact_headline_states_no_undefined_statistic() {
+    // Before the first stone reaches the panel the statistics are undefined (NaN): the headline says so
+    // in words instead of printing NaN; one impact has a mean but no standard deviation.
+    let none = results::Statistics::of(&[]);
+    let line = results::impact_headline(&none, &none);
+    assert!(!line.contains("NaN"), "{line}");
+    assert!(line.contains("no stone reached the panel"), "{line}");
+    let one = results::impact_headline(&results::Statistics::of(&[13.4]), &results::Statistics::of(&[54.0]));
+    assert!(!one.contains("NaN") && one.contains("13.40 m/s") && one.contains("54.0°"), "{one}");
+    assert!(!one.contains('±'), "{one}");
+    // Three impacts: mean 13, sample SD 1 (values 12, 13, 14), range 12–14.
+    let speed = results::Statistics::of(&[12.0, 13.0, 14.0]);
+    let angle = results::Statistics::of(&[50.0, 54.0, 58.0]);
+    let three = results::impact_headline(&speed, &angle);
+    assert_eq!(
+        three,
+        "first 3 stones on the panel: speed 13.00 ± 1.00 m/s (12.00–14.00), impact angle 54.0 ± 4.0° (50.0–58.0°)"
+    );
+}
