@@ -1,7 +1,7 @@
 //! Force evaluation: gravity and external forces, wall contacts, pair contacts.
 
 use super::{ParticleView, Simulation};
-use crate::contact::{ContactInput, ContactLaw, ContactOutput};
+use crate::contact::{ContactInput, ContactLaw};
 use crate::error::DemError;
 use crate::par::{run_groups, Group};
 use crate::walls::mesh::HitBuffer;
@@ -183,6 +183,18 @@ impl<L: ContactLaw> Simulation<L> {
             let mut hits = HitBuffer::default();
             for i in g.work_begin as usize..g.work_end as usize {
                 let (k0, k1) = (w_start[i] as usize, w_start[i + 1] as usize);
+                if k0 == k1 {
+                    continue;
+                }
+                let pi = WallParticle {
+                    id: id[i],
+                    r: radius[i],
+                    vel: vel[i],
+                    omega: omega[i],
+                    inv_mass: inv_mass[i],
+                    dt: cdt,
+                };
+                let (fi, ti) = (&mut f[i - pbase], &mut tq[i - pbase]);
                 let mut k = k0;
                 while k < k1 {
                     let w = w_wall[k] as usize;
@@ -193,73 +205,28 @@ impl<L: ContactLaw> Simulation<L> {
                     let wall = &walls[w];
                     let kw = &kin[w];
                     let pp = params.get(material[i] as usize, wall.material as usize);
-                    let r = radius[i];
-                    let reach = r + law.range(pp, r);
-                    let x_ref = kw.to_reference(pos[i]);
-                    let mut contact =
-                        |hit: WallHit, state: &mut L::State, out: &mut SlotOut, acc: &mut Acc| {
-                            let n = hit.normal;
-                            let v_wall = kw.velocity_at(hit.point);
-                            let c = ContactInput {
-                                normal: n,
-                                overlap: r - hit.distance,
-                                r_eff: r,
-                                radius_sum: r,
-                                m_eff: 1.0 / inv_mass[i],
-                                i_eff: 0.4 * r * r / inv_mass[i],
-                                v_rel: vel[i] - r * omega[i].cross(n) - v_wall,
-                                w_rel: omega[i] - kw.omega,
-                                dt: cdt,
-                            };
-                            let was_new = !out.active;
-                            match law.compute(pp, &c, state) {
-                                None => {
-                                    *state = default;
-                                    *out = SlotOut::default();
-                                }
-                                Some(o) => {
-                                    apply_wall(&o, n, r, i - pbase, f, tq);
-                                    acc.dissipated += o.dissipated;
-                                    acc.elastic += o.energy;
-                                    acc.wall_power += o.force.dot(v_wall) + o.rolling_torque.dot(kw.omega);
-                                    acc.wall_contacts += 1;
-                                    acc.note_overlap(c.overlap / r, id[i], u32::MAX);
-                                    let tangential_speed = if was_new {
-                                        let vc = vel[i] - v_wall;
-                                        (vc - vc.dot(n) * n).length()
-                                    } else {
-                                        0.0
-                                    };
-                                    *out = SlotOut {
-                                        active: true,
-                                        formed: was_new,
-                                        normal_force: o.normal_force,
-                                        approach_speed: -c.v_rel.dot(n),
-                                        tangential_speed,
-                                        force: o.force,
-                                    };
-                                }
-                            }
-                        };
+                    let reach = pi.r + law.range(pp, pi.r);
+                    let (states, outs) = (&mut states[k - sbase..e - sbase], &mut outs[k - sbase..e - sbase]);
                     match &wall.shape {
                         WallShape::Mesh(m) => {
+                            let x_ref = kw.to_reference(pos[i]);
                             m.resolve(x_ref, reach, &w_tri[k..e], &mut raw, &mut hits);
                             let hs = hits.as_slice();
-                            let accepted = |s: usize| hs.iter().any(|h| k + h.slot == s);
+                            let accepted = |s: usize| hs.iter().any(|h| h.slot == s);
                             // A contact that moved onto a neighbouring triangle inherits the state and
                             // the activity (it is not a new impact) of the nearest contact of this mesh
                             // that ended.
                             for h in hs {
-                                let s = k + h.slot;
-                                if outs[s - sbase].active {
+                                let s = h.slot;
+                                if outs[s].active {
                                     continue;
                                 }
                                 let mut best: Option<(f64, usize)> = None;
-                                for s2 in k..e {
-                                    if accepted(s2) || !outs[s2 - sbase].active {
+                                for s2 in 0..e - k {
+                                    if accepted(s2) || !outs[s2].active {
                                         continue;
                                     }
-                                    let [a, b, c] = m.mesh.corners(w_tri[s2] as usize);
+                                    let [a, b, c] = m.mesh.corners(w_tri[k + s2] as usize);
                                     let (q, _) =
                                         spatter_core::mesh::closest_point_on_triangle(h.point, a, b, c);
                                     let d = (q - h.point).length_squared();
@@ -268,36 +235,94 @@ impl<L: ContactLaw> Simulation<L> {
                                     }
                                 }
                                 if let Some((_, s2)) = best {
-                                    states[s - sbase] = states[s2 - sbase];
-                                    states[s2 - sbase] = default;
-                                    outs[s - sbase] = outs[s2 - sbase];
-                                    outs[s2 - sbase] = SlotOut::default();
+                                    states[s] = states[s2];
+                                    states[s2] = default;
+                                    outs[s] = outs[s2];
+                                    outs[s2] = SlotOut::default();
                                 }
                             }
-                            for s in k..e {
+                            for s in 0..e - k {
                                 if !accepted(s) {
-                                    states[s - sbase] = default;
-                                    outs[s - sbase] = SlotOut::default();
+                                    states[s] = default;
+                                    outs[s] = SlotOut::default();
                                 }
                             }
                             for h in hs {
                                 let hit = kw.hit_to_world(h.point, h.normal, h.distance);
-                                let s = k + h.slot - sbase;
-                                contact(hit, &mut states[s], &mut outs[s], &mut acc);
+                                let (state, out) = (&mut states[h.slot], &mut outs[h.slot]);
+                                if kw.fixed {
+                                    wall_contact::<L, false>(
+                                        law,
+                                        pp,
+                                        kw,
+                                        hit,
+                                        &pi,
+                                        state,
+                                        out,
+                                        (fi, ti),
+                                        &mut acc,
+                                    );
+                                } else {
+                                    wall_contact::<L, true>(
+                                        law,
+                                        pp,
+                                        kw,
+                                        hit,
+                                        &pi,
+                                        state,
+                                        out,
+                                        (fi, ti),
+                                        &mut acc,
+                                    );
+                                }
+                            }
+                        }
+                        _ if kw.fixed => {
+                            // A wall that never moves (the common case): no transforms, no wall velocity.
+                            for (state, out) in states.iter_mut().zip(outs.iter_mut()) {
+                                match wall.analytic_hit(pos[i], reach) {
+                                    Some((point, normal, distance)) => {
+                                        let hit = WallHit { point, normal, distance };
+                                        wall_contact::<L, false>(
+                                            law,
+                                            pp,
+                                            kw,
+                                            hit,
+                                            &pi,
+                                            state,
+                                            out,
+                                            (fi, ti),
+                                            &mut acc,
+                                        )
+                                    }
+                                    None => {
+                                        *state = default;
+                                        *out = SlotOut::default();
+                                    }
+                                }
                             }
                         }
                         _ => {
-                            for s in k..e {
+                            let x_ref = kw.to_reference(pos[i]);
+                            for (state, out) in states.iter_mut().zip(outs.iter_mut()) {
                                 match wall.analytic_hit(x_ref, reach) {
-                                    Some((q, nrm, d)) => contact(
-                                        kw.hit_to_world(q, nrm, d),
-                                        &mut states[s - sbase],
-                                        &mut outs[s - sbase],
-                                        &mut acc,
-                                    ),
+                                    Some((q, nrm, d)) => {
+                                        let hit = kw.hit_to_world(q, nrm, d);
+                                        wall_contact::<L, true>(
+                                            law,
+                                            pp,
+                                            kw,
+                                            hit,
+                                            &pi,
+                                            state,
+                                            out,
+                                            (fi, ti),
+                                            &mut acc,
+                                        )
+                                    }
                                     None => {
-                                        states[s - sbase] = default;
-                                        outs[s - sbase] = SlotOut::default();
+                                        *state = default;
+                                        *out = SlotOut::default();
                                     }
                                 }
                             }
@@ -766,8 +791,82 @@ impl<L: ContactLaw> PairStage<'_, L> {
     }
 }
 
-#[inline]
-fn apply_wall(o: &ContactOutput, n: Vec3, r: f64, i: usize, f: &mut [Vec3], tq: &mut [Vec3]) {
-    f[i] += o.force;
-    tq[i] += o.rolling_torque - r * n.cross(o.force);
+/// What the wall loop reads of the particle in contact, loaded once per particle.
+struct WallParticle {
+    id: u32,
+    /// Radius \[m\].
+    r: f64,
+    /// Velocity \[m/s\] and angular velocity \[rad/s\].
+    vel: Vec3,
+    omega: Vec3,
+    /// 1/m \[1/kg\].
+    inv_mass: f64,
+    /// The time over which the contact springs advance \[s\].
+    dt: f64,
+}
+
+/// One particle–wall contact at `hit` (world frame): the law, the force and torque on the particle (added
+/// to `fi`, `ti`), the slot's output and the sums. With `MOVING` false the wall is fixed (zero velocity
+/// everywhere, no work): the velocity terms are left out, which changes no bit of the result (subtracting
+/// a zero vector is exact).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn wall_contact<L: ContactLaw, const MOVING: bool>(
+    law: &L,
+    pp: &L::Params,
+    kw: &WallKinematics,
+    hit: WallHit,
+    p: &WallParticle,
+    state: &mut L::State,
+    out: &mut SlotOut,
+    (fi, ti): (&mut Vec3, &mut Vec3),
+    acc: &mut Acc,
+) {
+    let n = hit.normal;
+    let r = p.r;
+    let v_wall = if MOVING { kw.velocity_at(hit.point) } else { Vec3::ZERO };
+    let v_rel = if MOVING { p.vel - r * p.omega.cross(n) - v_wall } else { p.vel - r * p.omega.cross(n) };
+    let c = ContactInput {
+        normal: n,
+        overlap: r - hit.distance,
+        r_eff: r,
+        radius_sum: r,
+        m_eff: 1.0 / p.inv_mass,
+        i_eff: 0.4 * r * r / p.inv_mass,
+        v_rel,
+        w_rel: if MOVING { p.omega - kw.omega } else { p.omega },
+        dt: p.dt,
+    };
+    let was_new = !out.active;
+    match law.compute(pp, &c, state) {
+        None => {
+            *state = L::State::default();
+            *out = SlotOut::default();
+        }
+        Some(o) => {
+            *fi += o.force;
+            *ti += o.rolling_torque - r * n.cross(o.force);
+            acc.dissipated += o.dissipated;
+            acc.elastic += o.energy;
+            if MOVING {
+                acc.wall_power += o.force.dot(v_wall) + o.rolling_torque.dot(kw.omega);
+            }
+            acc.wall_contacts += 1;
+            acc.note_overlap(c.overlap / r, p.id, u32::MAX);
+            let tangential_speed = if was_new {
+                let vc = if MOVING { p.vel - v_wall } else { p.vel };
+                (vc - vc.dot(n) * n).length()
+            } else {
+                0.0
+            };
+            *out = SlotOut {
+                active: true,
+                formed: was_new,
+                normal_force: o.normal_force,
+                approach_speed: -c.v_rel.dot(n),
+                tangential_speed,
+                force: o.force,
+            };
+        }
+    }
 }
