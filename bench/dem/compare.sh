@@ -5,8 +5,9 @@
 #   QUICK=1 STEPS=200 bench/dem/compare.sh
 #   METHOD=chunks QUICK=1 bench/dem/compare.sh   # busy machine: fastest of 400 single steps each
 #
-# Needs `lmp` (Debian package `lammps`, GRANULAR package included) and cargo. Measure on a quiet
-# machine: the load average is printed first.
+# Needs `lmp` (Debian package `lammps`, GRANULAR package included) and cargo; with `mpirun` (OpenMPI)
+# LAMMPS also runs on two ranks, against spatter's two threads. Measure on a quiet machine: the load
+# average is printed first.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -69,10 +70,24 @@ loop="$(grep '^Loop time' "$work/log.lammps" | tail -1)"
 echo "LAMMPS: $loop"
 # "Loop time of T on P procs for N steps with M atoms"
 lammps="$(awk '{print $12 * $9 / $4}' <<<"$loop")"
+# LAMMPS on two MPI ranks (the same data file), when mpirun is there.
+lammps2=""
+if command -v mpirun >/dev/null; then
+    root_flag=""
+    [ "$(id -u)" = 0 ] && root_flag="--allow-run-as-root"
+    (cd "$work" && mpirun $root_flag --oversubscribe -n 2 lmp -in "$here/in.box" -var data "$work/box.data" \
+        -var lx "$lx" -var ly "$ly" -var steps "$steps" -log "$work/log2.lammps" -screen none)
+    loop2="$(grep '^Loop time' "$work/log2.lammps" | tail -1)"
+    echo "LAMMPS, 2 ranks: $loop2"
+    lammps2="$(awk '{print $12 * $9 / $4}' <<<"$loop2")"
+fi
 printf 'LAMMPS   1 thread : %.4e particle-steps/s\n' "$lammps"
+[ -n "$lammps2" ] && printf 'LAMMPS   2 ranks  : %.4e particle-steps/s\n' "$lammps2"
 printf 'spatter  1 thread : %.4e particle-steps/s\n' "$spatter1"
 printf 'spatter  2 threads: %.4e particle-steps/s (parallel efficiency %.0f %%)\n' "$spatter2" \
     "$(awk -v a="$spatter1" -v b="$spatter2" 'BEGIN {print 50 * b / a}')"
+[ -n "$lammps2" ] && printf 'ratio spatter 2 threads / LAMMPS 2 ranks: %.2f\n' \
+    "$(awk -v a="$spatter2" -v b="$lammps2" 'BEGIN {print a / b}')"
 printf 'spatter  1 thread : %.4e particle-steps/s with per-contact energy bookkeeping\n' "$spatterp"
 printf 'spatter  1 thread : %.4e particle-steps/s without energy bookkeeping\n' "$spatter0"
 printf 'ratio spatter/LAMMPS (1 thread): %.2f with the energy budget (residual, default), %.2f per contact, %.2f without\n' \

@@ -2,10 +2,42 @@
 //!
 //! `cargo run --release -p spatter-dem --example dem_bench -- [--quick] [--clumps] [--lammps-data box.data]
 //!  [--steps N] [--threads-only 1] [--per-contact | --no-energy] [--chunks N [--chunk-steps K]]`
+//!
+//! `--dump state.txt [--steps N] [--settle N] [--threads-only T]` writes the settled box and the box after
+//! N more steps (default 100) as the bits of every position, velocity, spin and energy account
+//! (`bench::state_bits`): compare the files of two builds to see whether a change kept the motion bit for
+//! bit. `--save-settled FILE` keeps the settled box (a checkpoint) and `--settled FILE` starts from it
+//! instead of settling, with `--dump` and `--lammps-data`: a profile (valgrind) then simulates only the
+//! steps it counts.
 //! With `--chunks`, prints the fastest and the median chunk; `DEM_BENCH_TRACE=1` lists every chunk time
 //! on stderr (bursts of slow steps are the shared host, not the code).
 
-use spatter_dem::bench::{dense_box, settle, time_run, write_lammps_data, BoxCase};
+use spatter_dem::bench::{
+    dense_box, run_state_bits, settle, state_bits, time_run, write_lammps_data, BoxCase,
+};
+use spatter_dem::contact::HertzMindlin;
+use spatter_dem::Simulation;
+
+/// The settled box: loaded from `--settled FILE` (a state saved by `--save-settled FILE`, so that a profile
+/// under valgrind need not simulate the settling), else settled here for `settle_steps` steps.
+fn settled_box(
+    case: &BoxCase,
+    settle_steps: u64,
+    flag: &dyn Fn(&str) -> Option<String>,
+) -> Simulation<HertzMindlin> {
+    let mut sim = dense_box(case);
+    if let Some(path) = flag("--settled") {
+        let state = spatter_io::checkpoint::load(std::path::Path::new(&path), 0).expect("--settled FILE");
+        sim.restore(state).expect("restoring the settled state");
+        return sim;
+    }
+    settle(&mut sim, settle_steps).expect("settling");
+    if let Some(path) = flag("--save-settled") {
+        spatter_io::checkpoint::save(std::path::Path::new(&path), 0, &sim.state())
+            .expect("--save-settled FILE");
+    }
+    sim
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -48,6 +80,21 @@ fn main() {
         }
         return;
     }
+    if let Some(path) = flag("--dump") {
+        // Byte-identity check: the settled box and the box after `--steps` more steps, as bits.
+        let case = if quick { BoxCase::quick() } else { BoxCase::full() };
+        let steps: u64 = flag("--steps").map(|s| s.parse().expect("--steps N")).unwrap_or(100);
+        let settle_steps: u64 = flag("--settle")
+            .map(|s| s.parse().expect("--settle N"))
+            .unwrap_or(if quick { 2000 } else { 4000 });
+        let threads: usize =
+            flag("--threads-only").map(|s| s.parse().expect("--threads-only N")).unwrap_or(1);
+        let sim = settled_box(&case, settle_steps, &flag);
+        let mut text = state_bits(&sim);
+        text.push_str(&run_state_bits(&case, &sim.state(), threads, steps, energy).expect("run"));
+        std::fs::write(&path, text).expect("writing the dump");
+        return;
+    }
     if let Some(path) = flag("--lammps-data") {
         // Settle, export for LAMMPS, and time the same state here.
         let case = if quick { BoxCase::quick() } else { BoxCase::full() };
@@ -55,8 +102,7 @@ fn main() {
         let settle_steps: u64 = flag("--settle")
             .map(|s| s.parse().expect("--settle N"))
             .unwrap_or(if quick { 2000 } else { 4000 });
-        let mut sim = dense_box(&case);
-        settle(&mut sim, settle_steps).expect("settling");
+        let sim = settled_box(&case, settle_steps, &flag);
         write_lammps_data(&sim, case.extent(), std::path::Path::new(&path)).expect("data file");
         let e = case.extent();
         println!("box_x {:.10e}", e.x);

@@ -349,19 +349,10 @@ pub fn time_run_with(
     sim.law.energy = energy.is_some();
     sim.energy_method = energy.unwrap_or_default();
     sim.restore(state.clone()).map_err(DemError::Resume)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| DemError::Config { key: "threads".into(), message: e.to_string() })?;
     let r0 = sim.rebuild_count();
     let e0 = sim.force_evaluations();
     let t = Instant::now();
-    pool.install(|| {
-        // An energy budget at the end, as a run's output step would ask for it.
-        sim.run_steps(steps.saturating_sub(1))?;
-        sim.request_energy();
-        sim.run_steps(steps.min(1))
-    })?;
+    run_on_threads(&mut sim, threads, steps)?;
     let seconds = t.elapsed().as_secs_f64();
     Ok(Timing {
         threads,
@@ -371,6 +362,74 @@ pub fn time_run_with(
         rebuilds: sim.rebuild_count() - r0,
         evaluations: sim.force_evaluations() - e0,
     })
+}
+
+/// Advances `sim` by `steps` steps on a pool of `threads` threads, with the energy budget requested in the
+/// last step, as a run's output step would ask for it.
+fn run_on_threads<L: crate::contact::ContactLaw>(
+    sim: &mut Simulation<L>,
+    threads: usize,
+    steps: u64,
+) -> Result<(), DemError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| DemError::Config { key: "threads".into(), message: e.to_string() })?;
+    pool.install(|| {
+        sim.run_steps(steps.saturating_sub(1))?;
+        sim.request_energy();
+        sim.run_steps(steps.min(1))
+    })
+}
+
+/// Restores `state` into a fresh box, advances it `steps` steps on `threads` threads as [`time_run`] does
+/// (energy budget `energy`, Verlet list) and returns the bits of the final state ([`state_bits`]): the
+/// reproducible check that a change to the engine left the motion bit for bit the same.
+pub fn run_state_bits(
+    case: &BoxCase,
+    state: &SimState<<HertzMindlin as crate::contact::ContactLaw>::State>,
+    threads: usize,
+    steps: u64,
+    energy: Option<crate::sim::EnergyMethod>,
+) -> Result<String, DemError> {
+    let mut sim = dense_box(case);
+    sim.law.energy = energy.is_some();
+    sim.energy_method = energy.unwrap_or_default();
+    sim.restore(state.clone()).map_err(DemError::Resume)?;
+    run_on_threads(&mut sim, threads, steps)?;
+    Ok(state_bits(&sim))
+}
+
+/// The state of `sim` as text that differs between two runs exactly when a bit of the motion or the
+/// energy budget differs: a header line with the step, the contact counts and the bits of the energy
+/// report, then one line per particle in id order, `id` followed by the IEEE-754 bits of x, v and ω
+/// (16 hex digits per component).
+pub fn state_bits<L: crate::contact::ContactLaw>(sim: &Simulation<L>) -> String {
+    use std::fmt::Write as _;
+    let e = sim.energy();
+    let mut s = format!(
+        "step {} pair_contacts {} wall_contacts {} energy",
+        sim.step_count(),
+        e.pair_contacts,
+        e.wall_contacts
+    );
+    for v in [e.kinetic, e.rotational, e.elastic, e.potential, e.dissipated, e.external_work, e.wall_work] {
+        let _ = write!(s, " {:016x}", v.to_bits());
+    }
+    s.push('\n');
+    let p = &sim.particles;
+    let mut order: Vec<usize> = (0..p.len()).collect();
+    order.sort_by_key(|&i| p.id[i]);
+    for i in order {
+        let _ = write!(s, "{}", p.id[i]);
+        for v in [p.pos[i], p.vel[i], p.omega[i]] {
+            for c in v.to_array() {
+                let _ = write!(s, " {:016x}", c.to_bits());
+            }
+        }
+        s.push('\n');
+    }
+    s
 }
 
 /// Runs the benchmark and returns the lines to print. `quick` uses the reduced box and fewer steps.
@@ -533,6 +592,25 @@ mod tests {
         settle(&mut sim, 4000).unwrap();
         let e = *sim.last_evaluation();
         assert!(e.pair_contacts > 0 && e.wall_contacts > 0, "{e:?}");
+    }
+
+    #[test]
+    fn state_bits_repeat_for_the_same_run_and_change_with_one_bit_of_state() {
+        // The byte-identity check of docs/dem.md §5: two runs from the same state on 1 and 2 threads print
+        // the same text (the engine is deterministic for any thread count, docs/dem.md §2), and a change
+        // of one velocity by one unit in the last place shows.
+        let case = BoxCase { cells: [3, 3, 2], ..BoxCase::full() };
+        let mut sim = dense_box(&case);
+        settle(&mut sim, 100).unwrap();
+        let state = sim.state();
+        let energy = Some(crate::sim::EnergyMethod::Residual);
+        let one = run_state_bits(&case, &state, 1, 20, energy).unwrap();
+        let two = run_state_bits(&case, &state, 2, 20, energy).unwrap();
+        assert_eq!(one, two);
+        assert_eq!(one.lines().count(), 1 + case.count());
+        let before = state_bits(&sim);
+        sim.particles.vel[5].x = f64::from_bits(sim.particles.vel[5].x.to_bits() ^ 1);
+        assert_ne!(before, state_bits(&sim));
     }
 
     #[test]

@@ -138,6 +138,17 @@ pub struct Hertz;
 pub struct HertzParams {
     /// E* \[Pa\].
     pub e_star: f64,
+    /// (4/3) E* \[Pa\], the force factor (precomputed: the same product the formula forms first).
+    pub force_factor: f64,
+    /// 2 E* \[Pa\], the damping stiffness per contact radius S_n/a.
+    pub stiffness_per_radius: f64,
+}
+
+impl HertzParams {
+    /// The parameters for effective modulus E* = `e_star` \[Pa\].
+    pub fn new(e_star: f64) -> Self {
+        HertzParams { e_star, force_factor: 4.0 / 3.0 * e_star, stiffness_per_radius: 2.0 * e_star }
+    }
 }
 
 impl NormalLaw for Hertz {
@@ -145,7 +156,7 @@ impl NormalLaw for Hertz {
     type State = ();
 
     fn params(&self, _pair_index: usize, props: &PairProps) -> HertzParams {
-        HertzParams { e_star: props.e_star }
+        HertzParams::new(props.e_star)
     }
 
     #[inline(always)]
@@ -155,10 +166,11 @@ impl NormalLaw for Hertz {
             return None;
         }
         let a = (c.r_eff * d).sqrt();
-        let force = 4.0 / 3.0 * p.e_star * a * d;
+        // (4/3 E*) a δ and (2E*) a, with the constant factors formed once per pair type.
+        let force = p.force_factor * a * d;
         Some(NormalForce {
             force,
-            damping_stiffness: 2.0 * p.e_star * a,
+            damping_stiffness: p.stiffness_per_radius * a,
             contact_radius: a,
             coulomb_force: None,
             energy: 0.4 * force * d,
@@ -170,6 +182,6 @@ impl NormalLaw for Hertz {
     }
 
     fn damping_stiffness_per_radius(&self, p: &HertzParams) -> Option<f64> {
-        Some(2.0 * p.e_star)
+        Some(p.stiffness_per_radius)
     }
 }

@@ -139,7 +139,7 @@ macro_rules! spring_law {
             type State = SpringHistory;
 
             fn params(&self, _pair_index: usize, props: &PairProps) -> MindlinParams {
-                MindlinParams { g_star: props.g_star, mu: props.friction }
+                MindlinParams::new(props.g_star, props.friction)
             }
 
             #[inline(always)]
@@ -200,6 +200,15 @@ pub struct MindlinParams {
     pub g_star: f64,
     /// Sliding friction coefficient μ.
     pub mu: f64,
+    /// 8 G* \[Pa\], the Mindlin stiffness per contact radius (k_t = 8 G* a), formed once per pair type.
+    pub stiffness_per_radius: f64,
+}
+
+impl MindlinParams {
+    /// The parameters for effective shear modulus G* = `g_star` \[Pa\] and friction coefficient `mu`.
+    pub fn new(g_star: f64, mu: f64) -> Self {
+        MindlinParams { g_star, mu, stiffness_per_radius: 8.0 * g_star }
+    }
 }
 
 /// Tangential history state: the spring displacement ξ \[m\] and the stiffness of the last step \[N/m\]
@@ -212,7 +221,7 @@ pub struct SpringHistory {
 
 spring_law!(
     Mindlin,
-    |_law, p, nf| 8.0 * p.g_star * nf.contact_radius,
+    |_law, p, nf| p.stiffness_per_radius * nf.contact_radius,
     |_law, p, sn_per_radius| mindlin_stiffness_ratio(p, sn_per_radius),
     |_law, _ratio| 1.0
 );
@@ -329,7 +338,7 @@ pub struct MindlinVariant {
 
 spring_law!(
     MindlinVariant,
-    |_law, p, nf| 8.0 * p.g_star * nf.contact_radius,
+    |_law, p, nf| p.stiffness_per_radius * nf.contact_radius,
     |_law, p, sn_per_radius| mindlin_stiffness_ratio(p, sn_per_radius),
     |law, ratio| law.history.scale(ratio)
 );

@@ -270,7 +270,7 @@ fn viscous_rolling_torque_has_the_model_b_value_and_direction() {
 /// stiffness `k0`, change the stiffness to `k1` at rest, then move back until the force has vanished.
 fn stiffness_cycle(history: MindlinHistory, k0: f64, k1: f64, d: f64) -> f64 {
     let law = MindlinVariant { history };
-    let p = MindlinParams { g_star: 1e9, mu: 1e9 };
+    let p = MindlinParams::new(1e9, 1e9);
     let mut s = SpringHistory::default();
     let (n, dt) = (20_000, 1e-6);
     let v = d / (n as f64 * dt);
@@ -353,7 +353,7 @@ fn rescaled_history_follows_the_contact_radius_only_when_it_shrinks() {
     // ξ = 1 µm stored at k_prev; the next step has no motion. ForceRescaled keeps the force when k grows
     // (scale k_prev/k) and scales it by a/a_prev when k shrinks (scale 1): exact arithmetic.
     let law = MindlinVariant { history: MindlinHistory::ForceRescaled };
-    let p = MindlinParams { g_star: 1e9, mu: 10.0 };
+    let p = MindlinParams::new(1e9, 10.0);
     let c = input(1e-6, Vec3::ZERO, 1e-3, 1e-3, 1e-6);
     for (k_prev, k, f_expected) in [(2e5, 4e5, 0.2), (4e5, 2e5, 0.2), (4e5, 1e5, 0.1)] {
         let mut s = SpringHistory { xi: Vec3::new(1e-6, 0.0, 0.0), k_prev };
