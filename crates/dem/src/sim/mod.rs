@@ -540,6 +540,27 @@ impl<L: ContactLaw> Simulation<L> {
         self.st.forces_valid = false;
     }
 
+    /// Replaces the persistent external force of every particle by `forces` \[N\] (one per particle, in
+    /// the current particle order; the external torques stay). Between velocity-Verlet steps the forces
+    /// of the current state are already evaluated and the next step's first half-kick uses them: they are
+    /// corrected by the change (members' forces too, then their bodies' sums), so that a force held for
+    /// the next N steps acts over exactly those N steps rather than half a step late.
+    pub fn replace_external_forces(&mut self, forces: &[Vec3]) {
+        debug_assert_eq!(forces.len(), self.particles.len());
+        let valid = self.st.forces_valid;
+        let p = &mut self.particles;
+        p.external_force_mut();
+        for (i, &f) in forces.iter().enumerate() {
+            if valid {
+                p.force[i] += f - p.ext_force[i];
+            }
+            p.ext_force[i] = f;
+        }
+        if valid && !self.st.bodies.is_empty() {
+            self.reduce_body_forces();
+        }
+    }
+
     /// Asks the next step to book the contacts' elastic energy (needed before [`Simulation::energy`] under
     /// [`EnergyMethod::Residual`]; a no-op cost-wise under per-contact bookkeeping).
     pub fn request_energy(&mut self) {

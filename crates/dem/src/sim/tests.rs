@@ -805,3 +805,46 @@ fn a_tabulated_floor_carries_a_sphere_along_its_prescribed_path() {
     assert!((e.total() - e0).abs() < 1e-4 * e.wall_work.abs(), "{e:?} vs {e0}");
     assert!(e.wall_work < 0.0, "the floor lowered the sphere: {e:?}");
 }
+
+#[test]
+fn a_replaced_external_force_acts_from_the_next_step_on_for_spheres_and_bodies() {
+    // A force held for N steps and then replaced (as a fluid coupling does between its sub-cycles): under
+    // velocity Verlet each sub-cycle changes a free sphere's and a rigid body's velocity by exactly
+    // N Δt F/m of its own force, the previous one leaving no half-kick behind (round-off, 1e-12).
+    use crate::clump::{ClumpTemplate, NewBody};
+    let mats = vec![soft()];
+    let mut sim = Simulation::new(
+        HertzMindlin::default(),
+        mats.clone(),
+        uniform_pairs(&mats, 0.5, 0.5),
+        1e-4,
+        Settings::default(),
+    );
+    sim.add_particle(crate::NewParticle::at(Vec3::ZERO, 0.01, 0));
+    let t = sim.add_template(ClumpTemplate::from_spheres(
+        "pair",
+        &[(Vec3::new(-0.01, 0.0, 0.0), 0.01), (Vec3::new(0.01, 0.0, 0.0), 0.01)],
+    ));
+    sim.add_clump(t, 0, NewBody::at(Vec3::new(1.0, 0.0, 0.0), spatter_core::Quat::IDENTITY)).unwrap();
+    let n = sim.particles.len();
+    let sphere = sim.particles.index_of(0).unwrap();
+    let m_sphere = sim.particles.mass(sphere);
+    let m_body = 1.0 / sim.bodies().inv_mass[0];
+    for (k, fx) in [0.02, -0.05, 0.03].into_iter().enumerate() {
+        // The same force on every particle: the body (two members) takes twice it.
+        sim.replace_external_forces(&vec![Vec3::new(fx, 0.0, 0.0); n]);
+        let (v_s, v_b) = (sim.particles.vel[sphere].x, sim.bodies().vel[0].x);
+        sim.run_steps(10).unwrap();
+        let tau = 10.0 * sim.dt;
+        let dv_s = sim.particles.vel[sphere].x - v_s;
+        let dv_b = sim.bodies().vel[0].x - v_b;
+        assert!(
+            (dv_s - tau * fx / m_sphere).abs() < 1e-12 * (tau * fx / m_sphere).abs(),
+            "sub-cycle {k}: sphere {dv_s}"
+        );
+        assert!(
+            (dv_b - tau * 2.0 * fx / m_body).abs() < 1e-12 * (tau * 2.0 * fx / m_body).abs(),
+            "sub-cycle {k}: body {dv_b}"
+        );
+    }
+}

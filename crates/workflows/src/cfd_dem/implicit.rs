@@ -208,16 +208,8 @@ impl Coupling {
         }
         // Velocity Verlet's first half step of the next DEM steps kicks with the force of the last
         // evaluation, which holds the previous coupling step's fluid force: it gets the new one, so that
-        // the spheres take exactly Σ e Δt_f (free spheres; bodies keep their reduced force).
-        let p = &mut dem.particles;
-        let had = p.ext_force.len() == n && p.force.len() == n;
-        for i in 0..n {
-            if had && p.inv_mass[i] > 0.0 && !p.is_member(i) {
-                p.force[i] += self.on_particles[i] - p.ext_force[i];
-            }
-        }
-        let (ext, _) = dem.particles.external_force_mut();
-        ext.copy_from_slice(&self.on_particles);
+        // the spheres take exactly Σ e Δt_f.
+        dem.replace_external_forces(&self.on_particles);
         let to = Vec3::from(flow.total_implicit_force());
         let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
         // Near equilibrium both sides are small differences of large terms (s − k u*, β̃ (ũ − ṽ)), so the

@@ -358,8 +358,9 @@ impl Coupling {
                 None => outside += 1,
             }
         }
-        let (ext, _) = dem.particles.external_force_mut();
-        ext.copy_from_slice(&self.on_particles);
+        // The new forces act from the next DEM step's first half-kick on (see
+        // `Simulation::replace_external_forces`).
+        dem.replace_external_forces(&self.on_particles);
         let to = Vec3::from(self.flow.total_body_force());
         let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
         let rel = (to + on_boundaries + from).length() / from.length().max(1e-300);
