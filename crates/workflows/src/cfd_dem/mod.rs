@@ -291,6 +291,20 @@ impl Coupling {
     /// the momentum balance. This is the explicit exchange; with `exchange = semi_implicit` a coupling
     /// step recomputes every force around its fluid step, so this serves for outputs only.
     pub fn exchange<L: ContactLaw>(&mut self, dem: &mut Simulation<L>) -> ExchangeReport {
+        let rep = self.compute_exchange(dem);
+        let t1 = Instant::now();
+        // The new forces act from the next DEM step's first half-kick on (see
+        // `Simulation::replace_external_forces`).
+        dem.replace_external_forces(&self.on_particles);
+        self.times.forces += t1.elapsed().as_secs_f64();
+        rep
+    }
+
+    /// [`Coupling::exchange`] without handing the forces to `dem`: the void fraction, the forces on the
+    /// spheres (`on_particles`), the fluid's body force and the momentum balance of the current state,
+    /// for outputs. A resumed run computes its first outputs this way, so the DEM's forces stay those of
+    /// the checkpoint and the run continues bit for bit.
+    pub fn compute_exchange<L: ContactLaw>(&mut self, dem: &Simulation<L>) -> ExchangeReport {
         let t1 = self.sample_fields(&dem.particles.pos, &dem.particles.radius);
         let p = &dem.particles;
         let n = p.len();
@@ -358,9 +372,6 @@ impl Coupling {
                 None => outside += 1,
             }
         }
-        // The new forces act from the next DEM step's first half-kick on (see
-        // `Simulation::replace_external_forces`).
-        dem.replace_external_forces(&self.on_particles);
         let to = Vec3::from(self.flow.total_body_force());
         let alpha_min = self.void_fraction.alpha.iter().copied().fold(1.0, f64::min);
         let rel = (to + on_boundaries + from).length() / from.length().max(1e-300);
@@ -459,6 +470,11 @@ impl<L: ContactLaw> Coupled<L> {
     /// stepping; returns the momentum balance.
     pub fn exchange(&mut self) -> ExchangeReport {
         self.coupling.exchange(&mut self.dem)
+    }
+
+    /// The same for outputs only: the DEM's forces are left as they are ([`Coupling::compute_exchange`]).
+    pub fn compute_exchange(&mut self) -> ExchangeReport {
+        self.coupling.compute_exchange(&self.dem)
     }
 
     /// One coupling step: exchange, one fluid step of Δt_f, N DEM steps.

@@ -335,7 +335,7 @@ fn drive<L: ContactLaw>(
                 let mut particles = PvdSeries::load_or_new(&particles_pvd).map_err(io_at(&particles_pvd))?;
                 particles.truncate_after(t).map_err(io_at(&particles_pvd))?;
                 let trajectories = trajectory_series(dem_cfg, dir, Some(st.trajectories_bytes))?;
-                let meshes = mesh_series(&sim, dir, Some(t))?;
+                let meshes = mesh_series(&sim, dir, Some(t), dem_cfg.output.mesh_vtu)?;
                 tracing::info!("resumed at t = {t:.6} s, coupling step {}", st.coupling_steps);
                 (st, series, probes, fields, particles, trajectories, meshes)
             }
@@ -394,7 +394,7 @@ fn drive<L: ContactLaw>(
                 let series = CsvSeries::create(&series_path, &SERIES).map_err(io_at(&series_path))?;
                 let probes = CsvSeries::create(&probes_path, &pcols).map_err(io_at(&probes_path))?;
                 let trajectories = trajectory_series(dem_cfg, dir, None)?;
-                let meshes = mesh_series(&sim, dir, None)?;
+                let meshes = mesh_series(&sim, dir, None, dem_cfg.output.mesh_vtu)?;
                 (
                     st,
                     series,
@@ -408,9 +408,10 @@ fn drive<L: ContactLaw>(
         };
     let mut c = Coupled::new(flow, sim, cfg.coupling)?;
     c.times = st.times;
-    // The void fraction and the exchanged forces of the current state, for the first outputs (a
-    // coupling step recomputes them from the same state, so this changes nothing that follows).
-    c.exchange();
+    // The void fraction and the exchanged forces of the current state, for the first outputs; the DEM's
+    // forces are not touched (a coupling step recomputes the exchange from the same state, and a resumed
+    // run must find the forces of its checkpoint, whichever exchange it uses).
+    c.compute_exchange();
     c.times = st.times;
     let end = dem_cfg.duration_s;
     let total_steps = (end / c.fluid_dt()).round().max(1.0) as u64;
@@ -458,7 +459,9 @@ fn drive<L: ContactLaw>(
         if t >= st.next_field - eps || done {
             write_snapshot(ctx, &mut fields, &mut particles, &c, st.field_count)?;
             if dem_cfg.output.mesh_vtu {
-                write_mesh_snapshots(&c.dem, ctx, &mut meshes, u64::from(st.field_count))?;
+                // Stamped with the fluid's time, as the fields and particles (the DEM's clock, a sum of
+                // N Δt_DEM per step, differs from it by round-off).
+                write_mesh_snapshots(&c.dem, ctx, &mut meshes, u64::from(st.field_count), t)?;
             }
             st.field_count += 1;
             tracing::info!(

@@ -475,18 +475,57 @@ fn a_cfd_dem_run_writes_the_dem_event_log_trajectories_and_mesh_snapshots_and_re
     let full = RunDir::create(&tmp.path().join("full")).unwrap();
     let s = run(&cfg, &RunContext::new(&full, &Unattended, false)).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.finished, Finished::Completed);
-    // Interrupted about 60 of 150 coupling steps in (the stop is polled once per coupling step) and resumed: the same files
-    // byte for byte, so the trajectories continue without a duplicated row and the event log carries on.
-    let part = RunDir::create(&tmp.path().join("part")).unwrap();
-    let stopped = run(&cfg, &RunContext::new(&part, &StopAfterPolls::new(63), false)).unwrap();
-    assert_eq!(stopped.finished, Finished::Interrupted);
-    assert_eq!(run(&cfg, &RunContext::new(&part, &Unattended, true)).unwrap().finished, Finished::Completed);
+    // Interrupted (the stop is polled once per coupling step) and resumed: the same files byte for byte,
+    // so the trajectories continue without a duplicated row and the event log carries on. Stopped about
+    // 60 of 150 coupling steps in, and in the step that writes the snapshot at 2 ms (its checkpoint then
+    // follows the snapshot, and the resume must keep it in the wall's series).
     let snapshots: Vec<String> = (0..4).map(|n| format!("walls/distributor_{n:05}.vtu")).collect();
     let files = ["events.csv", "trajectories.csv", "distributor_wall.pvd", "series.csv", "particles.pvd"];
-    for rel in files.iter().copied().chain(snapshots.iter().map(String::as_str)) {
-        let a = std::fs::read(full.root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-        let b = std::fs::read(part.root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-        assert!(a == b, "{rel} differs between the uninterrupted and the resumed run");
+    for polls in [63, 51] {
+        let part = RunDir::create(&tmp.path().join(format!("part_{polls}"))).unwrap();
+        let stopped = run(&cfg, &RunContext::new(&part, &StopAfterPolls::new(polls), false)).unwrap();
+        assert_eq!(stopped.finished, Finished::Interrupted);
+        assert_eq!(
+            run(&cfg, &RunContext::new(&part, &Unattended, true)).unwrap().finished,
+            Finished::Completed
+        );
+        for rel in files.iter().copied().chain(snapshots.iter().map(String::as_str)) {
+            let a = std::fs::read(full.root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+            let b = std::fs::read(part.root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+            assert!(
+                a == b,
+                "{rel} differs between the uninterrupted run and the one resumed after {polls} polls"
+            );
+        }
+    }
+    // The wall's snapshots carry the times of the fluid snapshots.
+    let times = |rel: &str| -> Vec<String> {
+        let text = std::fs::read_to_string(full.root().join(rel)).unwrap();
+        text.split("timestep=\"").skip(1).map(|t| t.split('"').next().unwrap().to_string()).collect()
+    };
+    assert_eq!(times("distributor_wall.pvd"), times("fields.pvd"));
+    assert_eq!(times("fields.pvd").len(), 4);
+    // The semi-implicit exchange resumes bit for bit too (a resumed run's first outputs compute the
+    // exchange without touching the DEM's forces).
+    let semi: CfdDemConfig =
+        toml::from_str(&format!("{}\n[coupling]\nexchange = \"semi_implicit\"\n", falling_beads_toml(&stl)))
+            .unwrap_or_else(|e| panic!("{e}"));
+    let full_semi = RunDir::create(&tmp.path().join("full_semi")).unwrap();
+    assert_eq!(
+        run(&semi, &RunContext::new(&full_semi, &Unattended, false)).unwrap().finished,
+        Finished::Completed
+    );
+    let part_semi = RunDir::create(&tmp.path().join("part_semi")).unwrap();
+    let stopped = run(&semi, &RunContext::new(&part_semi, &StopAfterPolls::new(63), false)).unwrap();
+    assert_eq!(stopped.finished, Finished::Interrupted);
+    assert_eq!(
+        run(&semi, &RunContext::new(&part_semi, &Unattended, true)).unwrap().finished,
+        Finished::Completed
+    );
+    for rel in ["series.csv", "trajectories.csv", "events.csv"] {
+        let a = std::fs::read(full_semi.root().join(rel)).unwrap();
+        let b = std::fs::read(part_semi.root().join(rel)).unwrap();
+        assert!(a == b, "semi-implicit: {rel} differs between the uninterrupted and the resumed run");
     }
     assert!(!full.root().join("walls/distributor_00004.vtu").exists(), "snapshots at 0, 2, 4, 6 ms only");
     for name in ["events.csv", "trajectories.csv", "distributor_wall.pvd"] {

@@ -226,9 +226,9 @@ pub(crate) struct Fluidisation {
     pub points: Vec<(f64, f64, f64, f64)>,
     /// The beads' weight less buoyancy per unit cross-section \[Pa\].
     pub weight_per_area: f64,
-    /// U_mf where the measured fixed-bed branch (Ergun's branch over the cells scaled by the
-    /// least-squares factor that matches the fixed levels) reaches the plateau (the mean pressure drop of
-    /// the fluidised levels) \[m/s\].
+    /// U_mf where the measured fixed-bed branch reaches the plateau (the mean pressure drop of the
+    /// fluidised levels): a U + b U² fitted to three or more fixed levels, or with two Ergun's branch over
+    /// the cells scaled by the least-squares factor that matches them \[m/s\].
     pub u_mf_knee: f64,
     /// The knee of Ergun's branch over the cells, a U + b U² through Ergun's pressure drops at the fixed
     /// levels, reaching the bed's weight less buoyancy per area \[m/s\].
@@ -374,17 +374,23 @@ pub(crate) fn fluidisation(
         return Err(format!("need two fixed and one fluidised level, got {points:?}"));
     }
     let plateau = fluid.iter().map(|p| p.1).sum::<f64>() / fluid.len() as f64;
-    // Ergun's branch over the cells, Δp_E = a U + b U², through its values at the fixed levels; the
-    // measured branch is that branch scaled by the least-squares factor s that best matches the measured
-    // levels. Fitting a and b to the measured levels themselves extrapolates a small difference between
-    // their errors into the knee: at these Reynolds numbers the U² term is a fifth of the drop at U_mf,
-    // and two fixed levels 1.5 % and 4.7 % below Ergun moved the fitted knee 12 % while the scaled branch
-    // moves it 3 %.
+    // Ergun's branch over the cells, Δp_E = a U + b U², through its values at the fixed levels.
     let ergun_cells: Vec<(f64, f64)> = fixed.iter().map(|p| (p.0, p.3)).collect();
     let (a, b) = fixed_bed_branch(&ergun_cells);
-    let s = fixed.iter().map(|p| p.1 * p.3).sum::<f64>() / fixed.iter().map(|p| p.3 * p.3).sum::<f64>();
-    let u_mf_knee = branch_reaches(s * a, s * b, plateau);
     let u_mf_ergun_cells = branch_reaches(a, b, weight_per_area);
+    // The measured branch: with three or more fixed levels a and b fitted to them. With two, a and b
+    // through two points extrapolate the difference between their errors into the knee (at these
+    // Reynolds numbers the U² term is a fifth of the drop at U_mf: levels 1.5 % and 4.7 % below Ergun
+    // put that knee 12 % above Ergun's), so Ergun's branch scaled by the least-squares factor s that
+    // matches the two levels stands for it; that knee follows from s and the plateau.
+    let u_mf_knee = if fixed.len() >= 3 {
+        let measured: Vec<(f64, f64)> = fixed.iter().map(|p| (p.0, p.1)).collect();
+        let (am, bm) = fixed_bed_branch(&measured);
+        branch_reaches(am, bm, plateau)
+    } else {
+        let s = fixed.iter().map(|p| p.1 * p.3).sum::<f64>() / fixed.iter().map(|p| p.3 * p.3).sum::<f64>();
+        branch_reaches(s * a, s * b, plateau)
+    };
     let eps_fixed = fixed.iter().map(|p| p.2).sum::<f64>() / fixed.len() as f64;
     Ok(Fluidisation { points, weight_per_area, u_mf_knee, u_mf_ergun_cells, plateau, eps_fixed })
 }
@@ -414,7 +420,7 @@ pub(crate) fn fluidisation_case(quick: bool) -> Vec<Check> {
     // Wen & Yu's general form is Ergun's balance at the bed's own porosity; their constants 33.7 and
     // 0.0408 fix ε_mf ≈ 0.38, while this narrow column packs looser and not uniformly (docs/cfd.md), so
     // the knee is compared with Ergun's balance over the bed's own cells.
-    let src = "Ergun (1952) summed over the cells, reaching the bed's weight (measured: that branch scaled to the fixed levels, reaching the plateau)";
+    let src = "Ergun (1952) summed over the cells, reaching the bed's weight (measured: a + bU fitted to 3 or more fixed levels, with 2 Ergun's branch scaled to them, reaching the plateau)";
     let r = if quick {
         fluidisation(2, 300, &[0.3, 0.6, 2.0], 0.25, 0.1)
     } else {

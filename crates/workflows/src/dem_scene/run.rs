@@ -565,7 +565,7 @@ impl OutputFiles {
             self.particles.push(t, rel).map_err(io(&ctx.dir.path("particles.pvd")))?;
         }
         if cfg.output.mesh_vtu {
-            write_mesh_snapshots(sim, ctx, &mut self.meshes, index)?;
+            write_mesh_snapshots(sim, ctx, &mut self.meshes, index, t)?;
         }
         Ok(())
     }
@@ -577,10 +577,11 @@ pub(crate) fn mesh_series<L: ContactLaw>(
     sim: &Simulation<L>,
     dir: &spatter_io::run::RunDir,
     resume: Option<f64>,
+    enabled: bool,
 ) -> Result<Vec<Option<PvdSeries>>, DemError> {
     let mut meshes = Vec::new();
     for w in 0..sim.walls.len() {
-        if !sim.is_mesh_wall(w) {
+        if !enabled || !sim.is_mesh_wall(w) {
             meshes.push(None);
             continue;
         }
@@ -605,8 +606,8 @@ pub(crate) fn write_mesh_snapshots<L: ContactLaw>(
     ctx: &RunContext,
     meshes: &mut [Option<PvdSeries>],
     index: u64,
+    t: f64,
 ) -> Result<(), DemError> {
-    let t = sim.time();
     for (w, series) in meshes.iter_mut().enumerate() {
         if let Some(series) = series {
             let rel = format!("walls/{}_{index:05}.vtu", sim.walls[w].name);
@@ -829,7 +830,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         let files = if root {
             let mut particles = PvdSeries::load_or_new(&pvd_path).map_err(io(&pvd_path))?;
             particles.truncate_after(t).map_err(io(&pvd_path))?;
-            let meshes = mesh_series(&sim, dir, Some(t))?;
+            let meshes = mesh_series(&sim, dir, Some(t), cfg.output.mesh_vtu)?;
             Some(OutputFiles {
                 csv: CsvSeries::resume(&csv_path, ENERGY_COLUMNS, ck.csv_bytes).map_err(io(&csv_path))?,
                 particles,
@@ -886,7 +887,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             sim.decompose_over(comm, &split_points(cfg, &sim))?;
         }
         let files = if root {
-            let meshes = mesh_series(&sim, dir, None)?;
+            let meshes = mesh_series(&sim, dir, None, cfg.output.mesh_vtu)?;
             Some(OutputFiles {
                 csv: CsvSeries::create(&csv_path, ENERGY_COLUMNS).map_err(io(&csv_path))?,
                 particles: PvdSeries::new(&pvd_path),
