@@ -43,6 +43,19 @@ pub(super) fn box_walls<L: ContactLaw>(
     sim.add_wall(Wall { name: "floor".into(), shape: floor, material: floor_mat, motion: Motion::Fixed });
 }
 
+/// A simulation of the soft test material (restitution 0.5, friction 0.5, Hertz–Mindlin, default
+/// settings) with time step `dt` \[s\] and no particles.
+pub(super) fn soft_sim(dt: f64) -> Simulation<HertzMindlin> {
+    let mats = vec![soft()];
+    Simulation::new(
+        HertzMindlin::default(),
+        mats.clone(),
+        uniform_pairs(&mats, 0.5, 0.5),
+        dt,
+        Settings::default(),
+    )
+}
+
 pub(super) fn soft() -> Material {
     Material::new(5e7, 0.3, 2500.0).unwrap()
 }
@@ -205,14 +218,7 @@ fn settled_pile_rests_and_the_floor_carries_its_weight() {
 #[test]
 fn blow_ups_name_the_particle_the_step_and_the_cause() {
     // Two spheres created overlapping by half a radius: stopped at once, the cause says so.
-    let mats = vec![soft()];
-    let mut sim = Simulation::new(
-        HertzMindlin::default(),
-        mats.clone(),
-        uniform_pairs(&mats, 0.5, 0.5),
-        1e-6,
-        Settings::default(),
-    );
+    let mut sim = soft_sim(1e-6);
     sim.add_particle(crate::NewParticle::at(Vec3::ZERO, 0.01, 0));
     let b = sim.add_particle(crate::NewParticle::at(Vec3::new(0.015, 0.0, 0.0), 0.01, 0));
     match sim.step() {
@@ -225,13 +231,7 @@ fn blow_ups_name_the_particle_the_step_and_the_cause() {
         other => panic!("expected a blow-up, got {other:?}"),
     }
     // A time step of 5 Rayleigh times: a fast impact on the floor overshoots; the message blames dt.
-    let mut sim = Simulation::new(
-        HertzMindlin::default(),
-        mats.clone(),
-        uniform_pairs(&mats, 0.5, 0.5),
-        1.0,
-        Settings::default(),
-    );
+    let mut sim = soft_sim(1.0);
     let mut p = crate::NewParticle::at(Vec3::new(0.0, 0.0, 0.0105), 0.01, 0);
     p.vel = Vec3::new(0.0, 0.0, -5.0);
     sim.add_particle(p);
@@ -329,14 +329,7 @@ fn external_force_hook_and_persistent_forces_act_and_are_booked() {
             }
         }
     }
-    let mats = vec![soft()];
-    let mut sim = Simulation::new(
-        HertzMindlin::default(),
-        mats.clone(),
-        uniform_pairs(&mats, 0.5, 0.5),
-        1e-4,
-        Settings::default(),
-    );
+    let mut sim = soft_sim(1e-4);
     sim.add_particle(crate::NewParticle::at(Vec3::ZERO, 0.01, 0));
     sim.add_particle(crate::NewParticle::at(Vec3::new(1.0, 0.0, 0.0), 0.01, 0));
     sim.set_external_forces(Box::new(Push(Vec3::new(0.0, 0.02, 0.0))));
@@ -358,14 +351,7 @@ fn a_rising_floor_lifts_a_sphere_and_the_wall_work_closes_the_budget() {
     // A plane moving up at 0.05 m/s under a resting sphere: the sphere ends up riding on it at the same
     // speed, and mechanical + dissipated − wall work stays at its initial value (1 % tolerance, see the
     // bookkeeping note above).
-    let mats = vec![soft()];
-    let mut sim = Simulation::new(
-        HertzMindlin::default(),
-        mats.clone(),
-        uniform_pairs(&mats, 0.5, 0.5),
-        2e-5,
-        Settings::default(),
-    );
+    let mut sim = soft_sim(2e-5);
     sim.gravity = Vec3::new(0.0, 0.0, -9.81);
     sim.add_wall(Wall {
         name: "lift".into(),
@@ -653,14 +639,7 @@ fn a_sphere_rolling_on_a_rotating_plate_orbits_at_two_sevenths_of_its_rate() {
     let r = 0.01;
     let v0 = 0.02;
     let run = |rolling: bool, steps: u64| {
-        let mats = vec![soft()];
-        let mut sim = Simulation::new(
-            HertzMindlin::default(),
-            mats.clone(),
-            uniform_pairs(&mats, 0.5, 0.5),
-            2e-5,
-            Settings::default(),
-        );
+        let mut sim = soft_sim(2e-5);
         sim.gravity = Vec3::new(0.0, 0.0, -9.81);
         sim.add_wall(Wall {
             name: "turntable".into(),
@@ -812,14 +791,7 @@ fn a_replaced_external_force_acts_from_the_next_step_on_for_spheres_and_bodies()
     // velocity Verlet each sub-cycle changes a free sphere's and a rigid body's velocity by exactly
     // N Δt F/m of its own force, the previous one leaving no half-kick behind (round-off, 1e-12).
     use crate::clump::{ClumpTemplate, NewBody};
-    let mats = vec![soft()];
-    let mut sim = Simulation::new(
-        HertzMindlin::default(),
-        mats.clone(),
-        uniform_pairs(&mats, 0.5, 0.5),
-        1e-4,
-        Settings::default(),
-    );
+    let mut sim = soft_sim(1e-4);
     sim.add_particle(crate::NewParticle::at(Vec3::ZERO, 0.01, 0));
     let t = sim.add_template(ClumpTemplate::from_spheres(
         "pair",
