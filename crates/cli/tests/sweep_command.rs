@@ -143,6 +143,32 @@ fn a_folder_of_another_study_is_refused_unless_overwritten() {
     assert!(table(&out).lines().count() == 7);
 }
 
+/// A base scenario edited after the study ran: its finished cases are stale. The rerun refuses and says
+/// so; with `--overwrite` it runs every changed case afresh (the table then holds the new results, not
+/// the old ones).
+#[test]
+fn a_changed_base_is_refused_and_rerun_afresh_with_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = study_files(dir.path());
+    let out = dir.path().join("out");
+    ok(&sweep(&[], &study, &out, None));
+    let before = table(&out);
+    write(
+        dir.path(),
+        "base.toml",
+        b"kind = \"snow_regime_map\"\nmode = \"bisection\"\nsvg = false\n[grid]\ndiameters = 5\n",
+    );
+    let o = sweep(&[], &study, &out, None);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("base scenario changed") && err.contains("--overwrite"), "{err}");
+    assert_eq!(table(&out), before, "nothing rewritten on refusal");
+    let again = ok(&sweep(&["--overwrite"], &study, &out, None));
+    assert!(again.contains("6 cases run, 0 already finished"), "{again}");
+    let case = std::fs::read_to_string(out.join("cases/case_00000/case.toml")).unwrap();
+    assert!(case.contains("diameters = 5"), "{case}");
+}
+
 /// Headless Chromium opens the study report and a run report: every picture decodes, no script error.
 /// Skipped (with a note) where Chromium is not installed, unless `SPATTER_REQUIRE_CHROMIUM=1` (CI).
 #[test]

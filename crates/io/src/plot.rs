@@ -77,6 +77,19 @@ pub fn tick_label(v: f64) -> String {
     }
 }
 
+/// A colour-bar label: `v` to four significant digits (the bar's ticks split its range in quarters, so
+/// they fall on arbitrary values; 2520.3676 reads 2520), as [`tick_label`] outside [1e-3, 1e4).
+pub fn colour_bar_label(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !(1e-3..1e4).contains(&a) {
+        return tick_label(v);
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
+    s.to_owned()
+}
+
 /// The tick label of `v` on a linear axis spanning `span` (0 for a log axis): a value within 1e-9 of the
 /// span from zero is rounding noise of a zero and is printed as `0` (an axis whose data start at a
 /// computed 2.7e-20 instead of 0 would otherwise label its first tick `2.711e-20`).
@@ -402,7 +415,7 @@ fn colour_bar<DB: DrawingBackend>(
         let f = k as f64 / 4.0;
         let y = y_at(f);
         root.draw(&PathElement::new(vec![(x1, y), (x1 + 4, y)], BLACK.stroke_width(1)))?;
-        let text = tick_label(vmin + f * (vmax - vmin));
+        let text = colour_bar_label(vmin + f * (vmax - vmin));
         root.draw(&Text::new(text, (x1 + 7, y - 7), ("sans-serif", 13)))?;
     }
     // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
@@ -804,6 +817,14 @@ mod tests {
         assert_eq!(axis_tick_label(2.711e-20, 1.4e-3), "0");
         assert_eq!(axis_tick_label(2e-4, 1.4e-3), "2e-4");
         assert_eq!(axis_tick_label(2.711e-20, 0.0), "2.711e-20");
+        // Colour bars: four significant digits.
+        assert_eq!(colour_bar_label(2520.3676), "2520");
+        assert_eq!(colour_bar_label(630.0919), "630.1");
+        assert_eq!(colour_bar_label(1.8382757), "1.838");
+        assert_eq!(colour_bar_label(0.0123456), "0.01235");
+        assert_eq!(colour_bar_label(-42.0), "-42");
+        assert_eq!(colour_bar_label(4.999999999999999e-6), "5e-6");
+        assert_eq!(colour_bar_label(0.0), "0");
     }
 
     #[test]

@@ -126,7 +126,8 @@ fn plot_output(
     let y = table.column(output);
     let x: Vec<f64> = plan.cases.iter().map(|c| number(&c.values[i])).collect();
     let key = &plan.keys[i];
-    let mut chart = Chart::new(&format!("{output} against {key}"), key, output);
+    // The legend beside the plot: inside it would hide the points of the top right corner.
+    let mut chart = Chart::new(&format!("{output} against {key}"), key, output).legend_right();
     if study.spec.vary[i].scale == Scale::Log && x.iter().all(|v| *v > 0.0) {
         chart = chart.log_x();
     }

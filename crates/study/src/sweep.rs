@@ -175,12 +175,17 @@ pub fn run_study(
         let dir = opts.out.join("cases").join(case_dir_name(case.index));
         let input = dir.join("case.toml");
         if let Ok(existing) = std::fs::read_to_string(&input) {
+            // The base scenario (or a default) changed since the case ran: its results are stale.
             if existing != case.text {
-                return Err(StudyError::Folder(format!(
-                    "{} differs from case {} of this study; pass --overwrite to start the study afresh",
-                    input.display(),
-                    case.index
-                )));
+                if !opts.overwrite {
+                    return Err(StudyError::Folder(format!(
+                        "{} differs from case {} of this study (the base scenario changed since it ran); \
+                         pass --overwrite to run the changed cases afresh",
+                        input.display(),
+                        case.index
+                    )));
+                }
+                std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
             }
         }
         let summary = SummaryFile::read(&dir).map_err(StudyError::Folder)?;

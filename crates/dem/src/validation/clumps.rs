@@ -439,16 +439,16 @@ pub(crate) fn dumbbell(r: f64) -> ClumpTemplate {
     ClumpTemplate::from_spheres("dumbbell", &[(Vec3::new(-r, 0.0, 0.0), r), (Vec3::new(r, 0.0, 0.0), r)])
 }
 
-/// Drops a body of template `t` with orientation `q` at `speed` \[m/s\] onto the plane z = 0 (no gravity,
-/// soft material on a rigid wall, restitution `e`, friction `mu`, time step `dt` \[s\]) and runs until the
-/// contact has ended. Returns the simulation and the velocity before; `None` if it never touched or blew
-/// up.
+/// Throws a body of template `t` with orientation `q` at velocity `v0` \[m/s\] (downwards, v0.z < 0) onto
+/// the plane z = 0 (no gravity, soft material on a rigid wall, restitution `e`, friction `mu`, time step
+/// `dt` \[s\]) and runs until the contact has ended. Returns the simulation and the velocity before; `None`
+/// if it never touched or blew up.
 pub(crate) fn drop_on_plane(
     t: ClumpTemplate,
     q: Quat,
     (e, mu): (f64, f64),
     settings: Settings,
-    speed: f64,
+    v0: Vec3,
     dt: f64,
 ) -> Option<(Simulation<HertzMindlin>, Vec3)> {
     let r = t.max_radius();
@@ -463,7 +463,6 @@ pub(crate) fn drop_on_plane(
     // The lowest member surface 0.2 r above the floor.
     let low = sim.templates()[ti].spheres.iter().map(|&(c, rr)| (q * c).z - rr).fold(f64::INFINITY, f64::min);
     let x0 = Vec3::new(0.0, 0.0, -low + 0.2 * r);
-    let v0 = Vec3::new(0.0, 0.0, -speed);
     sim.add_clump(ti, 0, NewBody { pos: x0, quat: q, vel: v0, omega: Vec3::ZERO }).ok()?;
     let mut touched = false;
     for _ in 0..(0.1 / dt) as usize {
@@ -481,7 +480,7 @@ pub(crate) fn drop_on_plane(
 pub(crate) fn dumbbell_flat_restitution(e: f64, mass: ClumpContactMass, dt: f64) -> (f64, f64) {
     let settings = Settings { clump_contact_mass: mass, ..Settings::default() };
     let r = 1e-3;
-    match drop_on_plane(dumbbell(r), Quat::IDENTITY, (e, 0.3), settings, 1.0, dt) {
+    match drop_on_plane(dumbbell(r), Quat::IDENTITY, (e, 0.3), settings, Vec3::new(0.0, 0.0, -1.0), dt) {
         Some((sim, v0)) => {
             let b = sim.bodies();
             (b.vel[0].z / -v0.z, b.omega[0].length() * r)
@@ -559,7 +558,8 @@ pub(crate) struct EndImpact {
 pub(crate) fn dumbbell_end_impact(tilt_deg: f64, speed: f64, dt: f64) -> Option<EndImpact> {
     let r = 1e-3;
     let q = Quat::from_rotation_y(tilt_deg.to_radians());
-    let (sim, v0) = drop_on_plane(dumbbell(r), q, (1.0, 0.0), Settings::default(), speed, dt)?;
+    let (sim, v0) =
+        drop_on_plane(dumbbell(r), q, (1.0, 0.0), Settings::default(), Vec3::new(0.0, 0.0, -speed), dt)?;
     let b = sim.bodies();
     let m = b.mass(0);
     let inertia = b.inertia(0);

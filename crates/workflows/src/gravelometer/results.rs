@@ -456,6 +456,13 @@ pub fn report(
             }
         }
     }
+    // Share of the first stones moving down when they strike (α > 90°): the study found more above 90°
+    // than below on the upright SAE panel, "under the influence of gravity".
+    let alphas = &quantities[1].2;
+    if !alphas.is_empty() {
+        let down = alphas.iter().filter(|&&a| a > 90.0).count();
+        summary.scalar("impact_angle_above_90_share", down as f64 / alphas.len() as f64);
+    }
     let path = dir.path("impact_statistics.csv");
     spatter_io::csv::write_table(&path, &["quantity", "n", "mean", "sd", "min", "max"], &rows)
         .map_err(io_err(&path))?;
