@@ -198,6 +198,8 @@ pub fn build_with(cfg: &SphConfig, comm: &dyn Comm) -> Result<(Simulation, Build
                 warnings.push(format!("wall `{}`: {note}", w.name));
             }
         }
+    } else if let Some(note) = inert_adhesion_note(cfg) {
+        warnings.push(note);
     }
 
     // Fluid.
@@ -247,4 +249,18 @@ pub fn build_with(cfg: &SphConfig, comm: &dyn Comm) -> Result<(Simulation, Build
     };
     sim.initialize_with(comm)?;
     Ok((sim, info))
+}
+
+/// Without surface tension the Akinci adhesion of every wall is zero (it is a multiple of the cohesion,
+/// [`SphParams::adhesion_per_factor`]): a note naming the walls whose `adhesion` would then do nothing.
+fn inert_adhesion_note(cfg: &SphConfig) -> Option<String> {
+    let named: Vec<&str> = cfg.walls.iter().filter(|w| w.adhesion > 0.0).map(|w| w.name.as_str()).collect();
+    (cfg.fluid.surface_tension_n_m <= 0.0 && !named.is_empty()).then(|| {
+        format!(
+            "fluid.surface_tension_n_m = 0: the adhesion of {} acts only with surface tension (the wall's \
+             pull is a multiple of the liquid's cohesion) and has no effect in this run; set \
+             surface_tension_n_m (0.072 N/m for water) for adhesion to act",
+            named.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+        )
+    })
 }

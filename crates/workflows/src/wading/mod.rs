@@ -15,6 +15,8 @@ pub mod channel;
 pub mod channel_stl;
 pub mod config;
 pub mod geometry;
+#[cfg(test)]
+mod knob_tests;
 pub mod layout;
 pub mod parts;
 pub mod patches;
