@@ -169,7 +169,8 @@ enum Command {
         /// Worker threads per case [default: all cores].
         #[arg(long)]
         threads: Option<usize>,
-        /// Delete another study's cases found in the folder instead of refusing.
+        /// Delete another study's cases found in the folder, and cases whose scenario changed since they
+        /// ran (an edited base), instead of refusing; the changed cases then run afresh.
         #[arg(long)]
         overwrite: bool,
     },

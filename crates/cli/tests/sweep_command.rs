@@ -143,9 +143,9 @@ fn a_folder_of_another_study_is_refused_unless_overwritten() {
     assert!(table(&out).lines().count() == 7);
 }
 
-/// A base scenario edited after the study ran: its finished cases are stale. The rerun refuses and says
-/// so; with `--overwrite` it runs every changed case afresh (the table then holds the new results, not
-/// the old ones).
+/// A base scenario edited after the study ran: its finished cases are stale. The rerun and `collect`
+/// refuse and say so, before running anything; with `--overwrite` the rerun deletes the changed cases and
+/// the collected results and runs every changed case afresh from the new base.
 #[test]
 fn a_changed_base_is_refused_and_rerun_afresh_with_overwrite() {
     let dir = tempfile::tempdir().unwrap();
@@ -162,7 +162,12 @@ fn a_changed_base_is_refused_and_rerun_afresh_with_overwrite() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("base scenario changed") && err.contains("--overwrite"), "{err}");
+    assert!(err.contains("case 0, case 1, case 2, case 3, case 4, case 5"), "{err}");
     assert_eq!(table(&out), before, "nothing rewritten on refusal");
+    let c = spatter().args(["sweep", "collect"]).arg(&study).arg("--out").arg(&out).output().unwrap();
+    let err = String::from_utf8_lossy(&c.stderr);
+    assert_eq!(c.status.code(), Some(1), "collect of stale cases must fail: {err}");
+    assert!(err.contains("base scenario changed"), "{err}");
     let again = ok(&sweep(&["--overwrite"], &study, &out, None));
     assert!(again.contains("6 cases run, 0 already finished"), "{again}");
     let case = std::fs::read_to_string(out.join("cases/case_00000/case.toml")).unwrap();

@@ -77,14 +77,17 @@ pub fn tick_label(v: f64) -> String {
     }
 }
 
-/// A colour-bar label: `v` to four significant digits (the bar's ticks split its range in quarters, so
-/// they fall on arbitrary values; 2520.3676 reads 2520), as [`tick_label`] outside [1e-3, 1e4).
-pub fn colour_bar_label(v: f64) -> String {
+/// A colour-bar label of `v` for ticks `step` apart: as many decimals as the step needs to tell ticks
+/// apart (one digit below the step's leading digit), trailing zeros dropped; as [`tick_label`] outside
+/// [1e-3, 1e4) or for a zero step. The bar's ticks split its range in quarters, so they fall on arbitrary
+/// values: 0…2520.3676 reads 630, 1260, 1890, 2520; 999…1001 reads 999, 999.5, 1000, 1000.5, 1001.
+pub fn colour_bar_label(v: f64, step: f64) -> String {
     let a = v.abs();
-    if v == 0.0 || !(1e-3..1e4).contains(&a) {
+    let step = step.abs();
+    if v == 0.0 || !(1e-3..1e4).contains(&a) || !step.is_normal() {
         return tick_label(v);
     }
-    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    let decimals = (1 - step.log10().floor() as i32).clamp(0, 9) as usize;
     let s = format!("{v:.decimals$}");
     let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
     s.to_owned()
@@ -415,7 +418,7 @@ fn colour_bar<DB: DrawingBackend>(
         let f = k as f64 / 4.0;
         let y = y_at(f);
         root.draw(&PathElement::new(vec![(x1, y), (x1 + 4, y)], BLACK.stroke_width(1)))?;
-        let text = colour_bar_label(vmin + f * (vmax - vmin));
+        let text = colour_bar_label(vmin + f * (vmax - vmin), (vmax - vmin) / 4.0);
         root.draw(&Text::new(text, (x1 + 7, y - 7), ("sans-serif", 13)))?;
     }
     // The label is wrapped to the colour-bar column (about 20 characters a line) so it is never cut off.
@@ -817,14 +820,16 @@ mod tests {
         assert_eq!(axis_tick_label(2.711e-20, 1.4e-3), "0");
         assert_eq!(axis_tick_label(2e-4, 1.4e-3), "2e-4");
         assert_eq!(axis_tick_label(2.711e-20, 0.0), "2.711e-20");
-        // Colour bars: four significant digits.
-        assert_eq!(colour_bar_label(2520.3676), "2520");
-        assert_eq!(colour_bar_label(630.0919), "630.1");
-        assert_eq!(colour_bar_label(1.8382757), "1.838");
-        assert_eq!(colour_bar_label(0.0123456), "0.01235");
-        assert_eq!(colour_bar_label(-42.0), "-42");
-        assert_eq!(colour_bar_label(4.999999999999999e-6), "5e-6");
-        assert_eq!(colour_bar_label(0.0), "0");
+        // Colour bars: the decimals the tick step needs.
+        let quarters = |lo: f64, hi: f64| -> Vec<String> {
+            (0..=4).map(|k| colour_bar_label(lo + k as f64 / 4.0 * (hi - lo), (hi - lo) / 4.0)).collect()
+        };
+        assert_eq!(quarters(0.0, 2520.3676), ["0", "630", "1260", "1890", "2520"]);
+        assert_eq!(quarters(999.0, 1001.0), ["999", "999.5", "1000", "1000.5", "1001"]);
+        assert_eq!(quarters(0.0, 0.01), ["0", "0.0025", "0.005", "0.0075", "0.01"]);
+        assert_eq!(quarters(-42.0, 42.0), ["-42", "-21", "0", "21", "42"]);
+        assert_eq!(colour_bar_label(4.999999999999999e-6, 1e-6), "5e-6");
+        assert_eq!(colour_bar_label(7.0, 0.0), "7");
     }
 
     #[test]

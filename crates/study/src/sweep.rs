@@ -18,7 +18,7 @@
 //! built from the case folders alone, one run, several shards, or a run killed and repeated all give the
 //! same table byte for byte.
 
-use crate::plan::{case_dir_name, table_text, Plan};
+use crate::plan::{case_dir_name, table_text, Case, Plan};
 use crate::spec::StudyFile;
 use crate::table::Table;
 use spatter_core::control::RunControl;
@@ -42,7 +42,8 @@ pub struct SweepOptions {
     pub out: PathBuf,
     /// `Some((i, n))`: run shard i of n (1-based) and leave the table to [`collect`].
     pub shard: Option<(usize, usize)>,
-    /// Delete the cases of a different study found in `out` instead of refusing.
+    /// Delete the cases of a different study found in `out`, and cases whose scenario changed since they
+    /// ran, instead of refusing.
     pub overwrite: bool,
 }
 
@@ -143,6 +144,62 @@ fn prepare(plan: &Plan, opts: &SweepOptions) -> Result<(), StudyError> {
     Ok(())
 }
 
+/// The cases among `cases` whose folder in `out` holds a `case.toml` other than the scenario the study now
+/// gives them: the base scenario (or a default) changed since they ran, so their results are stale.
+fn stale<'a>(cases: impl IntoIterator<Item = &'a Case>, out: &Path) -> Vec<usize> {
+    cases
+        .into_iter()
+        .filter(|c| {
+            let input = out.join("cases").join(case_dir_name(c.index)).join("case.toml");
+            std::fs::read_to_string(input).is_ok_and(|existing| existing != c.text)
+        })
+        .map(|c| c.index)
+        .collect()
+}
+
+/// "case 3, case 7, … (and N more)" for messages.
+fn case_list(indices: &[usize]) -> String {
+    let mut list: Vec<String> = indices.iter().take(12).map(|i| format!("case {i}")).collect();
+    if indices.len() > 12 {
+        list.push(format!("and {} more", indices.len() - 12));
+    }
+    list.join(", ")
+}
+
+/// Before any case runs: refuses stale cases (see [`stale`]), or with `overwrite` deletes their folders
+/// (checkpoints included: they belong to the old scenario) and the study's collected results, which
+/// describe them.
+fn clear_stale(cases: &[&Case], out: &Path, overwrite: bool) -> Result<(), StudyError> {
+    let changed = stale(cases.iter().copied(), out);
+    if changed.is_empty() {
+        return Ok(());
+    }
+    if !overwrite {
+        return Err(StudyError::Folder(format!(
+            "{}: the scenario of {} differs from what this study now gives them (the base scenario changed \
+             since they ran), so their results are stale; pass --overwrite to run them afresh",
+            out.display(),
+            case_list(&changed)
+        )));
+    }
+    for &i in &changed {
+        let dir = out.join("cases").join(case_dir_name(i));
+        std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+    }
+    for entry in std::fs::read_dir(out).map_err(io_err(out))?.flatten() {
+        let (path, name) = (entry.path(), entry.file_name());
+        if name == "cases" || name == "plan.csv" || name == LOG_FILE {
+            continue;
+        }
+        if path.is_dir() {
+            std::fs::remove_dir_all(&path).map_err(io_err(&path))?;
+        } else {
+            std::fs::remove_file(&path).map_err(io_err(&path))?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs the cases of `plan` (those of the shard, if one is given) and, for a whole study, collects the
 /// results. Finished cases are skipped, interrupted cases resume from their checkpoint.
 pub fn run_study(
@@ -164,6 +221,7 @@ pub fn run_study(
         Some((i, n)) => plan.shard(i, n).collect(),
         None => plan.cases.iter().collect(),
     };
+    clear_stale(&cases, &opts.out, opts.overwrite)?;
     let mut outcome =
         SweepOutcome { ran: 0, skipped: 0, failed: Vec::new(), interrupted: false, written: Vec::new() };
     for (done, case) in cases.iter().enumerate() {
@@ -174,20 +232,6 @@ pub fn run_study(
         }
         let dir = opts.out.join("cases").join(case_dir_name(case.index));
         let input = dir.join("case.toml");
-        if let Ok(existing) = std::fs::read_to_string(&input) {
-            // The base scenario (or a default) changed since the case ran: its results are stale.
-            if existing != case.text {
-                if !opts.overwrite {
-                    return Err(StudyError::Folder(format!(
-                        "{} differs from case {} of this study (the base scenario changed since it ran); \
-                         pass --overwrite to run the changed cases afresh",
-                        input.display(),
-                        case.index
-                    )));
-                }
-                std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
-            }
-        }
         let summary = SummaryFile::read(&dir).map_err(StudyError::Folder)?;
         if summary.as_ref().is_some_and(SummaryFile::completed) {
             outcome.skipped += 1;
@@ -251,6 +295,15 @@ pub fn collect(study: &StudyFile, plan: &Plan, out: &Path) -> Result<Vec<(String
                 out.display()
             )))
         }
+    }
+    let changed = stale(&plan.cases, out);
+    if !changed.is_empty() {
+        return Err(StudyError::Folder(format!(
+            "{}: {} ran with another scenario than this study now gives them (the base scenario changed \
+             since); rerun the study (or its shards) with --overwrite and collect again",
+            out.display(),
+            case_list(&changed)
+        )));
     }
     let table = Table::read(plan, out);
     let missing = table.unfinished();

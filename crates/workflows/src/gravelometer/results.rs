@@ -456,9 +456,10 @@ pub fn report(
             }
         }
     }
-    // Share of the first stones moving down when they strike (α > 90°): the study found more above 90°
-    // than below on the upright SAE panel, "under the influence of gravity".
-    let alphas = &quantities[1].2;
+    // Share of the first stones striking with α > 90°, against the panel's up direction (moving down on
+    // the upright SAE panel): the study found more above 90° than below there, "under the influence of
+    // gravity". Over the stones with a defined angle.
+    let alphas: Vec<f64> = quantities[1].2.iter().copied().filter(|a| a.is_finite()).collect();
     if !alphas.is_empty() {
         let down = alphas.iter().filter(|&&a| a > 90.0).count();
         summary.scalar("impact_angle_above_90_share", down as f64 / alphas.len() as f64);
