@@ -7,13 +7,17 @@ use common::*;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
+/// The study's base scenario: a small snow bisection over `diameters` grain diameters.
+fn write_base(dir: &Path, diameters: u32) {
+    let text = format!(
+        "kind = \"snow_regime_map\"\nmode = \"bisection\"\nsvg = false\n[grid]\ndiameters = {diameters}\n"
+    );
+    write(dir, "base.toml", text.as_bytes());
+}
+
 /// A small snow bisection (4 diameters) and a 2 × 3 grid study over it.
 fn study_files(dir: &Path) -> PathBuf {
-    write(
-        dir,
-        "base.toml",
-        b"kind = \"snow_regime_map\"\nmode = \"bisection\"\nsvg = false\n[grid]\ndiameters = 4\n",
-    );
+    write_base(dir, 4);
     write(
         dir,
         "study.toml",
@@ -153,11 +157,7 @@ fn a_changed_base_is_refused_and_rerun_afresh_with_overwrite() {
     let out = dir.path().join("out");
     ok(&sweep(&[], &study, &out, None));
     let before = table(&out);
-    write(
-        dir.path(),
-        "base.toml",
-        b"kind = \"snow_regime_map\"\nmode = \"bisection\"\nsvg = false\n[grid]\ndiameters = 5\n",
-    );
+    write_base(dir.path(), 5);
     let o = sweep(&[], &study, &out, None);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
