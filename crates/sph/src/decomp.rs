@@ -44,6 +44,16 @@ use spatter_core::{Aabb, Vec3};
 /// Halo width in kernel supports (see the module documentation).
 const HALO_SUPPORTS: f64 = 2.0;
 
+/// Steps between two checks of the load balance (one reduction of two numbers each).
+pub const REBALANCE_CHECK_STEPS: u64 = 20;
+
+/// Default load imbalance above which a split is rebuilt ([`Simulation::set_rebalance`]).
+pub const DEFAULT_REBALANCE: f64 = 1.2;
+
+pub(crate) fn default_rebalance() -> Option<f64> {
+    Some(DEFAULT_REBALANCE)
+}
+
 /// This rank's share of a decomposed run.
 #[derive(Clone, Debug)]
 pub(crate) struct Decomp {
@@ -64,6 +74,8 @@ pub(crate) struct Decomp {
     /// Bytes sent in the last halo exchange and migration (diagnostics).
     pub(crate) last_halo: usize,
     pub(crate) last_migrants: usize,
+    /// Times the split was rebuilt for balance since this rank's state was made or loaded.
+    rebalances: u64,
 }
 
 impl Decomp {
@@ -136,6 +148,7 @@ impl Simulation {
         if !self.initialized {
             self.initialize_with(comm)?;
         }
+        self.rebalance_if_needed(comm);
         let dt = self.dt;
         let t1 = self.time + dt;
         let mut clock = std::time::Instant::now();
@@ -196,6 +209,48 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets the load imbalance (the most particles on one rank over the mean) above which a run on
+    /// several ranks rebuilds its split from where the particles are now; `None` keeps the first split
+    /// for the whole run. Default [`DEFAULT_REBALANCE`]; values below 1 are taken as 1.
+    pub fn set_rebalance(&mut self, imbalance: Option<f64>) {
+        self.rebalance = imbalance.map(|v| v.max(1.0));
+    }
+
+    /// Times the split was rebuilt for balance since this state was made or loaded (0 on one rank).
+    pub fn rebalances(&self) -> u64 {
+        self.decomp.as_ref().map_or(0, |d| d.rebalances)
+    }
+
+    /// Dynamic load balancing, at the start of a step every [`REBALANCE_CHECK_STEPS`] steps: when the
+    /// imbalance exceeds the limit, the split is rebuilt over the particles where they are
+    /// ([`Rcb::rebalanced`]) and the step's migration takes every particle to its new owner. The decision
+    /// and the new split depend on the state only, so a resumed run rebalances where the uninterrupted
+    /// one did. A new split no better than the old (particles sharing coordinates on a lattice) or fewer
+    /// particles than ranks keeps the old split. Collective.
+    fn rebalance_if_needed(&mut self, comm: &dyn Comm) {
+        let (Some(limit), Some(d)) = (self.rebalance, self.decomp.as_ref()) else { return };
+        if self.steps % REBALANCE_CHECK_STEPS != 0 {
+            return;
+        }
+        let now = Rcb::imbalance(comm, self.fluid.len());
+        if now <= limit {
+            return;
+        }
+        let count = d.rebalances + 1;
+        let Ok((rcb, after)) =
+            Rcb::rebalanced(comm, &self.fluid.id, &self.fluid.pos, self.domain, self.periodic)
+        else {
+            return;
+        };
+        if after >= now {
+            return;
+        }
+        self.install_partition(rcb, comm);
+        if let Some(d) = self.decomp.as_mut() {
+            d.rebalances = count;
+        }
+    }
+
     /// Takes `rcb` as the split of space over the ranks of `comm` (boxes, neighbours, empty halo lists).
     fn install_partition(&mut self, rcb: Rcb, comm: &dyn Comm) {
         let rank = comm.rank();
@@ -215,6 +270,7 @@ impl Simulation {
             halo_rho: Vec::new(),
             last_halo: 0,
             last_migrants: 0,
+            rebalances: 0,
         });
         self.work.ready = false;
         self.work.walls_built = false;

@@ -40,6 +40,7 @@ use std::mem::take;
 
 #[path = "decomp.rs"]
 mod decomp;
+pub use decomp::{DEFAULT_REBALANCE, REBALANCE_CHECK_STEPS};
 
 /// Wall properties shared by every kind of part.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -192,6 +193,11 @@ pub struct Simulation {
     /// This rank's share of space when the run is split over several ranks (None on one rank).
     #[serde(skip)]
     decomp: Option<decomp::Decomp>,
+    /// On several ranks: the load imbalance (most particles on a rank over the mean) above which the
+    /// split is rebuilt from where the particles are ([`Self::set_rebalance`]); `None` never. Not part of
+    /// a checkpoint: the scenario sets it again on a resume.
+    #[serde(skip, default = "decomp::default_rebalance")]
+    rebalance: Option<f64>,
 }
 
 impl Simulation {
@@ -215,6 +221,7 @@ impl Simulation {
             initialized: false,
             work: Work::default(),
             decomp: None,
+            rebalance: decomp::default_rebalance(),
         }
     }
 

@@ -122,6 +122,15 @@ fn bad_values_are_named_with_their_key() {
     let errs = Checker::run(&cfg, None).unwrap_err();
     assert_eq!(errs[0].key, "walls[0].motion", "{errs:?}");
     assert!(toml::from_str::<SphConfig>(&SMALL.replace("[output]", "[output]\nunknown_key = 1")).is_err());
+    for v in ["0.5", "nan"] {
+        let cfg: SphConfig = toml::from_str(
+            &SMALL.replace("[output]", &format!("[domain]\nrebalance_imbalance = {v}\n[output]")),
+        )
+        .unwrap();
+        let errs = Checker::run(&cfg, None).unwrap_err();
+        assert_eq!(errs[0].key, "domain.rebalance_imbalance", "{errs:?}");
+        assert!(errs[0].message.contains("is outside [1, inf]"), "{errs:?}");
+    }
 }
 
 #[test]
@@ -642,9 +651,14 @@ fn run_on_ranks(
 /// A run on two thread-ranks stopped part-way (after writing a checkpoint at every step, so old
 /// generations are deleted as new ones are complete) and resumed on two ranks leaves every file, byte for
 /// byte, as the uninterrupted two-rank run: each rank continues from its own part with the same split.
+/// The split is rebuilt at every balance check that finds the counts unequal (`rebalance_imbalance = 1`,
+/// every 20 steps), so the stop falls between rebalances and the resumed run must rebuild where the
+/// uninterrupted one did.
 #[test]
 fn a_run_on_two_ranks_resumes_bit_for_bit() {
-    let text = SMALL.replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwall_particles = true");
+    let text = SMALL
+        .replace("sample_interval_s = 0.002", "sample_interval_s = 0.002\nwall_particles = true")
+        .replace("[output]", "[domain]\nrebalance_imbalance = 1.0\n[output]");
     let cfg = config(&text);
     let tmp = tempfile::tempdir().unwrap();
     let (full, split) = (tmp.path().join("full"), tmp.path().join("split"));

@@ -45,6 +45,9 @@ use spatter_core::{Aabb, Vec3};
 /// Particles per parallel block of the ghost contact loop.
 const BLOCK: usize = 1024;
 
+/// Default load imbalance above which a split is rebuilt ([`Simulation::set_rebalance`]).
+pub const DEFAULT_REBALANCE: f64 = 1.2;
+
 /// The particles of other ranks near this rank's box, and the contacts of owned particles with them.
 #[derive(Clone, Debug)]
 pub(crate) struct Ghosts<S> {
@@ -118,6 +121,8 @@ pub(crate) struct Decomp<S> {
     fresh: bool,
     /// Particles received by migration at the last rebuild.
     last_migrants: usize,
+    /// Times the split was rebuilt for balance since this rank's state was made or loaded.
+    rebalances: u64,
 }
 
 /// A state written for another rank ([`bincode`]: the exact bits of every number).
@@ -266,6 +271,7 @@ impl<L: ContactLaw> Simulation<L> {
             pending,
             fresh: false,
             last_migrants: 0,
+            rebalances: 0,
         });
         Ok(())
     }
@@ -316,6 +322,7 @@ impl<L: ContactLaw> Simulation<L> {
             pending: Default::default(),
             fresh: false,
             last_migrants: 0,
+            rebalances: 0,
         });
         let r_max = self.st.r_max;
         let (range_pp, _) = self.range_max(r_max);
@@ -448,6 +455,7 @@ impl<L: ContactLaw> Simulation<L> {
             wall_carry.extend(wc);
         }
         self.remove_outside_domain();
+        self.rebalance_if_needed(comm);
         let mut r = [self.particles.radius.iter().copied().fold(0.0, f64::max)];
         comm.all_max_f64(&mut r);
         let r_max = r[0];
@@ -462,6 +470,46 @@ impl<L: ContactLaw> Simulation<L> {
         self.exchange_ghosts(comm, width);
         self.build_ghost_list(range_pp, &carry);
         self.finish_rebuild();
+    }
+
+    /// Sets the load imbalance (the most particles on one rank over the mean) above which a run on
+    /// several ranks rebuilds its split, at a neighbour-list rebuild, from where the particles are;
+    /// `None` keeps the first split. Default [`DEFAULT_REBALANCE`]; values below 1 are taken as 1.
+    pub fn set_rebalance(&mut self, imbalance: Option<f64>) {
+        self.rebalance = imbalance.map(|v| v.max(1.0));
+    }
+
+    /// Times the split was rebuilt for balance since this state was made or loaded (0 on one rank).
+    pub fn rebalances(&self) -> u64 {
+        self.decomp.as_ref().map_or(0, |d| d.rebalances)
+    }
+
+    /// Dynamic load balancing at a neighbour-list rebuild (the only time particles change owner): when
+    /// the imbalance exceeds the limit, the split is rebuilt over the particles where they are
+    /// ([`Rcb::rebalanced`]), and the rebuild's migration takes every particle, with its contact history,
+    /// to its new owner. Depends on the state only, so a resumed run rebalances where the uninterrupted
+    /// one did. A new split no better than the old (particles sharing coordinates) or fewer particles
+    /// than ranks keeps the old split. Collective.
+    fn rebalance_if_needed(&mut self, comm: &dyn Comm) {
+        let (Some(limit), Some(d)) = (self.rebalance, self.decomp.as_ref()) else { return };
+        let now = Rcb::imbalance(comm, self.particles.len());
+        if now <= limit {
+            return;
+        }
+        let domain = d.rcb.domain();
+        let Ok((rcb, after)) =
+            Rcb::rebalanced(comm, &self.particles.id, &self.particles.pos, domain, [false; 3])
+        else {
+            return;
+        };
+        if after >= now {
+            return;
+        }
+        if let Some(d) = self.decomp.as_mut() {
+            d.boxes = rcb.boxes();
+            d.rcb = rcb;
+            d.rebalances += 1;
+        }
     }
 
     /// Sends every particle outside this rank's box to its owner, with its wall carries and the pair

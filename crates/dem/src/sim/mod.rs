@@ -25,7 +25,7 @@ mod neighbors;
 mod repartition;
 mod schemes;
 
-pub use decomp::RankState;
+pub use decomp::{RankState, DEFAULT_REBALANCE};
 pub use impacts::WallImpact;
 pub use integrate::Integrator;
 pub use neighbors::{PairList, WallList};
@@ -336,6 +336,8 @@ pub struct Simulation<L: ContactLaw> {
     evaluations: u64,
     /// This rank's share of a run split over several ranks (`None` on one rank).
     decomp: Option<decomp::Decomp<L::State>>,
+    /// On several ranks: the load imbalance above which the split is rebuilt ([`Self::set_rebalance`]).
+    rebalance: Option<f64>,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -377,6 +379,7 @@ impl<L: ContactLaw> Simulation<L> {
             stage: Default::default(),
             evaluations: 0,
             decomp: None,
+            rebalance: Some(decomp::DEFAULT_REBALANCE),
         }
     }
 

@@ -266,6 +266,19 @@ pub struct EngineConfig {
     /// Integrate the spins of the spheres (default true); false keeps every sphere at ω = 0.
     #[serde(default = "yes")]
     pub rotation: bool,
+    /// On several MPI ranks: the load imbalance (the most particles on one rank over the mean, ≥ 1)
+    /// above which the split of space is rebuilt at a neighbour-list rebuild. Default 1.2; `inf` keeps
+    /// the first split for the whole run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rebalance_imbalance: Option<f64>,
+}
+
+impl EngineConfig {
+    /// The limit for [`spatter_dem::sim::Simulation::set_rebalance`]: `None` for never (`inf`).
+    pub fn rebalance(&self) -> Option<f64> {
+        let v = self.rebalance_imbalance.unwrap_or(spatter_dem::sim::DEFAULT_REBALANCE);
+        v.is_finite().then_some(v)
+    }
 }
 
 fn residual() -> spatter_dem::sim::EnergyMethod {
@@ -291,6 +304,7 @@ impl Default for EngineConfig {
             energy_method: residual(),
             clump_contact_mass: Default::default(),
             rotation: true,
+            rebalance_imbalance: None,
         }
     }
 }
@@ -856,6 +870,9 @@ impl Validate for SceneConfig {
             }
             if let Some(v) = e.impact_speed_m_s {
                 c.positive("impact_speed_m_s", v);
+            }
+            if let Some(v) = e.rebalance_imbalance {
+                c.in_range("rebalance_imbalance", v, 1.0, true, f64::INFINITY, true);
             }
             if let Some(scheme) = e.integrator.scheme() {
                 if scheme.is_implicit() && e.iterations.unwrap_or(0) == 0 {

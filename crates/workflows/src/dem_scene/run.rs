@@ -719,6 +719,7 @@ pub fn simulation<L: ContactLaw>(law: L, built: setup::Built, cfg: &SceneConfig)
     sim.energy_method =
         if e.track_energy { e.energy_method } else { spatter_dem::sim::EnergyMethod::PerContact };
     sim.gravity = cfg.gravity_m_s2;
+    sim.set_rebalance(e.rebalance());
     for w in built.walls {
         sim.add_wall(w);
     }

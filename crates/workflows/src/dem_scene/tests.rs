@@ -188,6 +188,7 @@ fn validation_names_the_bad_keys() {
     cfg.pair_defaults.restitution = 1.5;
     cfg.walls[0].material = "wood".into();
     cfg.fill[0].size = Some(spatter_core::distribution::SizeDistribution::Mono { diameter: -1.0 });
+    cfg.engine.rebalance_imbalance = Some(0.9);
     let errs = Checker::run(&cfg, None).unwrap_err();
     let find =
         |k: &str| errs.iter().find(|e| e.key == k).unwrap_or_else(|| panic!("no error for {k}: {errs:?}"));
@@ -196,6 +197,7 @@ fn validation_names_the_bad_keys() {
     assert_eq!(find("pair_defaults.restitution").message, "restitution = 1.5 is outside (0, 1]");
     assert!(find("walls[0].material").message.contains("wood"));
     assert!(find("fill[0].size").message.contains("diameter = -1"));
+    assert_eq!(find("engine.rebalance_imbalance").message, "rebalance_imbalance = 0.9 is outside [1, inf]");
     let bad = "dt_s = 1e-5\nduration_s = 1\n[materials.a]\nyoungs_modulus_pa = 1e9\npoisson_ratio = 0.3\ndensity_kg_m3 = 1000\nunknown_key = 3\n";
     assert!(toml::from_str::<SceneConfig>(bad).is_err(), "unknown keys are rejected");
 }

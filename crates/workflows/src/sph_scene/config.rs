@@ -167,6 +167,19 @@ pub struct DomainConfig {
     /// Periodic axes among "x", "y", "z" (need `min_m`/`max_m`).
     #[serde(default)]
     pub periodic: Vec<String>,
+    /// On several MPI ranks: the load imbalance (the most fluid particles on one rank over the mean,
+    /// ≥ 1) above which the split of space is rebuilt from where the particles are; checked every 20
+    /// steps. Default 1.2; `inf` keeps the first split for the whole run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rebalance_imbalance: Option<f64>,
+}
+
+impl DomainConfig {
+    /// The limit for [`spatter_sph::Simulation::set_rebalance`]: `None` for never (`inf`).
+    pub fn rebalance(&self) -> Option<f64> {
+        let v = self.rebalance_imbalance.unwrap_or(spatter_sph::sim::DEFAULT_REBALANCE);
+        v.is_finite().then_some(v)
+    }
 }
 
 pub use crate::motions::{MotionConfig, MotionType};
@@ -461,6 +474,9 @@ impl Validate for SphConfig {
             }
             if !d.periodic.is_empty() && (d.min_m.is_none() || d.max_m.is_none()) {
                 c.fail("periodic", "periodic axes need the domain box `min_m` and `max_m`");
+            }
+            if let Some(v) = d.rebalance_imbalance {
+                c.in_range("rebalance_imbalance", v, 1.0, true, f64::INFINITY, true);
             }
         });
         crate::motions::check_tree(c, &self.motions);

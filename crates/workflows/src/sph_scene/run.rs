@@ -368,6 +368,8 @@ pub fn run(cfg: &SphConfig, ctx: &RunContext) -> Result<RunSummary, SphError> {
         }
         (st, series, pvd)
     };
+    // Not part of a checkpoint: the scenario's value, also on a resume.
+    st.sim.set_rebalance(cfg.domain.rebalance());
     let end = cfg.output.end_time_s;
     let vtu_dt = cfg.output.vtu_interval();
     let sample_dt = cfg.output.sample_interval();
@@ -770,6 +772,24 @@ fn finish(cfg: &SphConfig, ctx: &RunContext, mut st: SceneState, wall: f64) -> R
     }
     summary.scalars.append(&mut splash_scalars);
     summary.headline.push(cost);
+    if comm.is_root() {
+        if sim.ranks() > 1 {
+            tracing::info!(
+                "load balance: the split of space was rebuilt {} time(s) this session",
+                sim.rebalances()
+            );
+        }
+        let ph = sim.phase_times();
+        tracing::info!(
+            "step phases on rank 0 (s, this session): predict {:.2}, walls and guard {:.2}, sort {:.2}, wall state {:.2}, forces {:.2}, correct {:.2}",
+            ph.predict,
+            ph.walls_guard,
+            ph.sort,
+            ph.wall_state,
+            ph.forces,
+            ph.correct
+        );
+    }
     summary.artifacts.push(("particles (ParaView)".into(), dir.path("particles.pvd")));
     summary.artifacts.push(("time series".into(), dir.path("series.csv")));
     spatter_io::rank_checkpoint::remove(dir.root()).map_err(io_at(&dir.checkpoint_path()))?;

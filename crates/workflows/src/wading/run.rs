@@ -476,6 +476,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
         min_m: Some(Vec3::new((plan.x_front0 - reach).min(x_lo) - 1.0, y_lo - 1.0, floor - 1.0)),
         max_m: Some(Vec3::new(x_hi + 1.0, y_hi + 1.0, top)),
         periodic: Vec::new(),
+        rebalance_imbalance: None,
     };
     let bin = cfg.output.splash_bin_over_depth * x;
     let bins = (cfg.output.splash_top_over_depth / cfg.output.splash_bin_over_depth).ceil() as usize;
