@@ -13,7 +13,7 @@
 //! * [`wetting`] — wetting maps and wet areas at wall-particle resolution;
 //! * [`sessile`] — contact angle of a sessile drop for a given adhesion (calibration);
 //! * [`validation`] — reference cases for `spatter validate`; [`wheel_wading`] — the wheel rolling through
-//!   still water among them;
+//!   still water among them, with [`wheel_loads`], the hydrostatic loads it is held against;
 //! * [`sim`] — the [`Simulation`] and its time step (velocity Verlet with one force evaluation per step).
 //!
 //! See `docs/sph.md` for the equations, defaults and references.
@@ -36,6 +36,7 @@ pub mod sessile;
 pub mod sim;
 pub mod validation;
 pub mod wetting;
+pub mod wheel_loads;
 pub mod wheel_wading;
 
 pub use error::SphError;

@@ -680,7 +680,7 @@ mod tests {
         assert_all_pass(&submerged_solid(true));
     }
 
-    /// The quick wheel through still water (`crate::wheel_wading`): about 80 CPU-seconds.
+    /// The quick wheel through still water (`crate::wheel_wading`): under 2 CPU-minutes.
     #[test]
     fn wheel_wading_quick() {
         assert_all_pass(&crate::wheel_wading::wheel_wading(true));
