@@ -587,7 +587,8 @@ fn dem_box(count: usize, d: f64, lo: [f64; 3], hi: [f64; 3], end: f64) -> String
 /// balancing off (`engine.rebalance_imbalance = inf`), 30 grains falling down a column split along its
 /// height over 4 ranks all land in the lowest ranks' boxes, and the run ends with every grain, the two
 /// upper ranks' pieces of the last output empty. With balancing on (the default, 1.2) the split follows
-/// the grains down and every rank ends with its share (measured: 7, 8, 7, 8).
+/// the grains down and every rank ends with its share (on 2 ranks here; on 4 the same run ended with 7, 8,
+/// 7 and 8 grains).
 #[test]
 fn more_ranks_than_particles_is_refused_and_empty_ranks_run() {
     let tmp = tempfile::tempdir().unwrap();
@@ -619,20 +620,24 @@ fn more_ranks_than_particles_is_refused_and_empty_ranks_run() {
     }
     let column = dem_box(30, 0.02, [0.0, 0.0, 0.1], [0.1, 0.1, 0.5], 0.3);
     let mut counts = Vec::new();
-    for (name, engine) in [("fixed", "[engine]\nrebalance_imbalance = inf\n"), ("balanced", "")] {
+    // Balanced on 2 ranks: 4 oversubscribed ranks on a loaded two-core machine take minutes for the
+    // 6 000 steps once every rank holds grains.
+    for (name, engine, ranks) in [("fixed", "[engine]\nrebalance_imbalance = inf\n", 4), ("balanced", "", 2)]
+    {
         let path = common::write(tmp.path(), &format!("{name}.toml"), (column.clone() + engine).as_bytes());
         let out = tmp.path().join(name);
-        let o = mpirun(4, &["run", path.to_str().unwrap(), "--threads", "1", "--out", out.to_str().unwrap()]);
+        let o =
+            mpirun(ranks, &["run", path.to_str().unwrap(), "--threads", "1", "--out", out.to_str().unwrap()]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let count = |r: usize| {
             let piece = out.join(format!("particles/particles_00001_r{r:04}.vtu"));
             spatter_io::vtk::read(&piece).unwrap().points.len()
         };
-        let c: Vec<usize> = (0..4).map(count).collect();
+        let c: Vec<usize> = (0..ranks).map(count).collect();
         assert_eq!(c.iter().sum::<usize>(), 30, "{name}: {c:?}");
         counts.push(c);
     }
     assert_eq!(counts[0][2] + counts[0][3], 0, "the upper ranks' boxes emptied: {:?}", counts[0]);
     let most = *counts[1].iter().max().unwrap() as f64;
-    assert!(most <= 1.2 * 30.0 / 4.0, "balanced split: {:?}", counts[1]);
+    assert!(most <= 1.2 * 30.0 / 2.0, "balanced split: {:?}", counts[1]);
 }
