@@ -204,6 +204,27 @@ impl Rcb {
         self.domain
     }
 
+    /// Dynamic load balancing: when the imbalance of the particles each rank owns now
+    /// ([`Self::imbalance`]) exceeds `limit`, the split [`Self::rebalanced`] builds over them, unless it
+    /// would be no better (particles sharing coordinates on a lattice) or cannot be built (fewer
+    /// particles than ranks); otherwise `None`, keep the split in force. Depends on the particles only,
+    /// so every rank gets the same answer. Collective.
+    pub fn improved(
+        comm: &dyn Comm,
+        limit: f64,
+        ids: &[u32],
+        pos: &[Vec3],
+        domain: Aabb,
+        periodic: [bool; 3],
+    ) -> Option<Self> {
+        let now = Self::imbalance(comm, pos.len());
+        if now <= limit {
+            return None;
+        }
+        let (rcb, after) = Self::rebalanced(comm, ids, pos, domain, periodic).ok()?;
+        (after < now).then_some(rcb)
+    }
+
     /// Number of ranks.
     pub fn ranks(&self) -> usize {
         self.ranks

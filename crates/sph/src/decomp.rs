@@ -223,28 +223,17 @@ impl Simulation {
 
     /// Dynamic load balancing, at the start of a step every [`REBALANCE_CHECK_STEPS`] steps: when the
     /// imbalance exceeds the limit, the split is rebuilt over the particles where they are
-    /// ([`Rcb::rebalanced`]) and the step's migration takes every particle to its new owner. The decision
+    /// ([`Rcb::improved`]) and the step's migration takes every particle to its new owner. The decision
     /// and the new split depend on the state only, so a resumed run rebalances where the uninterrupted
-    /// one did. A new split no better than the old (particles sharing coordinates on a lattice) or fewer
-    /// particles than ranks keeps the old split. Collective.
+    /// one did. Collective.
     fn rebalance_if_needed(&mut self, comm: &dyn Comm) {
         let (Some(limit), Some(d)) = (self.rebalance, self.decomp.as_ref()) else { return };
         if self.steps % REBALANCE_CHECK_STEPS != 0 {
             return;
         }
-        let now = Rcb::imbalance(comm, self.fluid.len());
-        if now <= limit {
-            return;
-        }
         let count = d.rebalances + 1;
-        let Ok((rcb, after)) =
-            Rcb::rebalanced(comm, &self.fluid.id, &self.fluid.pos, self.domain, self.periodic)
-        else {
-            return;
-        };
-        if after >= now {
-            return;
-        }
+        let f = &self.fluid;
+        let Some(rcb) = Rcb::improved(comm, limit, &f.id, &f.pos, self.domain, self.periodic) else { return };
         self.install_partition(rcb, comm);
         if let Some(d) = self.decomp.as_mut() {
             d.rebalances = count;

@@ -191,6 +191,22 @@ fn window(s: &[WheelSample], from: f64, to: f64) -> WheelSample {
     }
 }
 
+/// The set-up of the validation case at spacing `dp` \[m\].
+fn case_run(dp: f64) -> WheelRun {
+    WheelRun {
+        radius: 0.3,
+        width: 0.1,
+        channel_width: 0.4,
+        depth: 0.2,
+        speed: 1.0,
+        ramp: 0.1,
+        dp,
+        t_end: 1.25,
+        ahead: 0.6,
+        behind: 0.1,
+    }
+}
+
 /// `sph_wheel_wading`: a wheel R = 0.3 m, b = 0.1 m in a channel 0.4 m wide, water h = 0.2 m deep
 /// (h < R), U = 1 m/s (Froude number U/√(gh) = 0.71; velocity head U²/2g = 51 mm), ω = U/R, started
 /// over 0.1 s and run for 1.25 s. Sampled every 10 ms; compared over 0.75–1.25 s. The wheel blocks a
@@ -215,19 +231,7 @@ fn window(s: &[WheelSample], from: f64, to: f64) -> WheelSample {
 /// wake's level, so the vertical estimate does not converge; F_x and the other checks pass at both
 /// spacings.
 pub fn wheel_wading(quick: bool) -> Vec<Check> {
-    let dp = if quick { 0.025 } else { 0.0125 };
-    let w = WheelRun {
-        radius: 0.3,
-        width: 0.1,
-        channel_width: 0.4,
-        depth: 0.2,
-        speed: 1.0,
-        ramp: 0.1,
-        dp,
-        t_end: 1.25,
-        ahead: 0.6,
-        behind: 0.1,
-    };
+    let w = case_run(if quick { 0.025 } else { 0.0125 });
     let s = wheel_through_water(&w, 0.01);
     wheel_checks(&w, &s)
 }
@@ -304,21 +308,6 @@ fn wheel_checks(w: &WheelRun, s: &[WheelSample]) -> Vec<Check> {
 mod tests {
     use super::*;
 
-    fn run(dp: f64) -> WheelRun {
-        WheelRun {
-            radius: 0.3,
-            width: 0.1,
-            channel_width: 0.4,
-            depth: 0.2,
-            speed: 1.0,
-            ramp: 0.1,
-            dp,
-            t_end: 1.25,
-            ahead: 0.6,
-            behind: 0.1,
-        }
-    }
-
     /// Samples of a steady state whose loads are the hydrostatic estimate of their levels, with the
     /// mantle wetted down to 20 mm on the front and 30 mm on the rear.
     fn steady_samples(w: &WheelRun, force: impl Fn(f64) -> Vec3) -> Vec<WheelSample> {
@@ -357,7 +346,7 @@ mod tests {
     /// (1 − 0.25)²/2g = 0.0287 m (tolerance 0.0125 m).
     #[test]
     fn load_checks_compare_with_the_levels_and_can_fail() {
-        let w = run(0.0125);
+        let w = case_run(0.0125);
         let (h, r, b) = (w.depth, w.radius, w.width);
         let (hf, hw) = (h + 0.06, h - 0.03);
         let fx = hydrostatic_drag(b, hf, hw);

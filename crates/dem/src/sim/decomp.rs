@@ -486,25 +486,13 @@ impl<L: ContactLaw> Simulation<L> {
 
     /// Dynamic load balancing at a neighbour-list rebuild (the only time particles change owner): when
     /// the imbalance exceeds the limit, the split is rebuilt over the particles where they are
-    /// ([`Rcb::rebalanced`]), and the rebuild's migration takes every particle, with its contact history,
+    /// ([`Rcb::improved`]), and the rebuild's migration takes every particle, with its contact history,
     /// to its new owner. Depends on the state only, so a resumed run rebalances where the uninterrupted
-    /// one did. A new split no better than the old (particles sharing coordinates) or fewer particles
-    /// than ranks keeps the old split. Collective.
+    /// one did. Collective.
     fn rebalance_if_needed(&mut self, comm: &dyn Comm) {
         let (Some(limit), Some(d)) = (self.rebalance, self.decomp.as_ref()) else { return };
-        let now = Rcb::imbalance(comm, self.particles.len());
-        if now <= limit {
-            return;
-        }
-        let domain = d.rcb.domain();
-        let Ok((rcb, after)) =
-            Rcb::rebalanced(comm, &self.particles.id, &self.particles.pos, domain, [false; 3])
-        else {
-            return;
-        };
-        if after >= now {
-            return;
-        }
+        let p = &self.particles;
+        let Some(rcb) = Rcb::improved(comm, limit, &p.id, &p.pos, d.rcb.domain(), [false; 3]) else { return };
         if let Some(d) = self.decomp.as_mut() {
             d.boxes = rcb.boxes();
             d.rcb = rcb;
