@@ -18,6 +18,17 @@ use serde::{Deserialize, Serialize};
 /// Largest number of points a rebalanced split is built from ([`Rcb::rebalanced`]).
 pub const REBALANCE_SAMPLE: u64 = 1 << 20;
 
+/// Default load imbalance (most particles on one rank over the mean) above which the engines rebuild
+/// their split ([`Rcb::improved`]).
+pub const DEFAULT_REBALANCE: f64 = 1.2;
+
+/// The imbalance limit of a scenario's `rebalance_imbalance` key: the default when it is absent, `None`
+/// (never rebalance) for `inf`.
+pub fn rebalance_limit(key: Option<f64>) -> Option<f64> {
+    let v = key.unwrap_or(DEFAULT_REBALANCE);
+    v.is_finite().then_some(v)
+}
+
 /// One node of the tree: a leaf names its rank; a split sends `x[axis] < at` to `lo`, the rest to `hi`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 enum Node {

@@ -47,8 +47,7 @@ const HALO_SUPPORTS: f64 = 2.0;
 /// Steps between two checks of the load balance (one reduction of two numbers each).
 pub const REBALANCE_CHECK_STEPS: u64 = 20;
 
-/// Default load imbalance above which a split is rebuilt ([`Simulation::set_rebalance`]).
-pub const DEFAULT_REBALANCE: f64 = 1.2;
+pub use spatter_core::rcb::DEFAULT_REBALANCE;
 
 pub(crate) fn default_rebalance() -> Option<f64> {
     Some(DEFAULT_REBALANCE)

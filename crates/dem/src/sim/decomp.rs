@@ -45,8 +45,7 @@ use spatter_core::{Aabb, Vec3};
 /// Particles per parallel block of the ghost contact loop.
 const BLOCK: usize = 1024;
 
-/// Default load imbalance above which a split is rebuilt ([`Simulation::set_rebalance`]).
-pub const DEFAULT_REBALANCE: f64 = 1.2;
+pub use spatter_core::rcb::DEFAULT_REBALANCE;
 
 /// The particles of other ranks near this rank's box, and the contacts of owned particles with them.
 #[derive(Clone, Debug)]

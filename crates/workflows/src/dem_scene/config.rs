@@ -276,8 +276,7 @@ pub struct EngineConfig {
 impl EngineConfig {
     /// The limit for [`spatter_dem::sim::Simulation::set_rebalance`]: `None` for never (`inf`).
     pub fn rebalance(&self) -> Option<f64> {
-        let v = self.rebalance_imbalance.unwrap_or(spatter_dem::sim::DEFAULT_REBALANCE);
-        v.is_finite().then_some(v)
+        spatter_core::rcb::rebalance_limit(self.rebalance_imbalance)
     }
 }
 

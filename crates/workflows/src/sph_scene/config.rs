@@ -177,8 +177,7 @@ pub struct DomainConfig {
 impl DomainConfig {
     /// The limit for [`spatter_sph::Simulation::set_rebalance`]: `None` for never (`inf`).
     pub fn rebalance(&self) -> Option<f64> {
-        let v = self.rebalance_imbalance.unwrap_or(spatter_sph::sim::DEFAULT_REBALANCE);
-        v.is_finite().then_some(v)
+        spatter_core::rcb::rebalance_limit(self.rebalance_imbalance)
     }
 }
 
