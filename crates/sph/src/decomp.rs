@@ -31,7 +31,12 @@
 //! particles are neighbours like periodic images), so results agree with a one-rank run to round-off,
 //! which grows where the flow is chaotic; the particle set and the total mass are exact.
 //!
-//! Surface tension and wall adhesion (which needs it) run on one rank only in this version.
+//! **Surface tension and wall adhesion** need two quantities each owner computes from its whole
+//! neighbourhood: the surface normal of every particle (the curvature term pairs the normals of
+//! neighbours) and the adhesion acceleration a wall's particles pull every fluid particle with (the walls
+//! push back on it in their extrapolated state). Both are sent to the halo after they are computed, over
+//! the lists of that step's halo exchange: two more neighbour exchanges per step, only when the run has
+//! surface tension (normals) and an adhesive wall (adhesion).
 
 use super::{PartLoad, PassStats, Simulation};
 use crate::error::SphError;
@@ -70,6 +75,10 @@ pub(crate) struct Decomp {
     /// Velocity and density of the received halo particles, by receive slot.
     halo_vel: Vec<Vec3>,
     halo_rho: Vec<f64>,
+    /// Adhesion acceleration of the received halo particles, by receive slot, from their owners' walls
+    /// (exchanged with the wall state when wall adhesion acts; positions do not change until the next
+    /// exchange, so sensors between steps reuse it).
+    halo_adh: Vec<Vec3>,
     /// Bytes sent in the last halo exchange and migration (diagnostics).
     pub(crate) last_halo: usize,
     pub(crate) last_migrants: usize,
@@ -174,7 +183,7 @@ impl Simulation {
         self.work.times.walls_guard += lap();
         self.prepare_sets_with(comm);
         self.work.times.sort += lap();
-        let st = self.passes_timed(dt, &mut lap);
+        let st = self.passes_timed(dt, &mut lap, comm);
         self.accumulate_wetting(dt);
         self.correct(dt);
         self.time = t1;
@@ -190,13 +199,6 @@ impl Simulation {
     pub fn decompose(&mut self, comm: &dyn Comm) -> Result<(), SphError> {
         if comm.size() == 1 || self.decomp.is_some() {
             return Ok(());
-        }
-        if self.params.surface_tension > 0.0 {
-            return Err(SphError::Setup(format!(
-                "surface tension (and wall adhesion, which needs it) runs on one rank only in this version; \
-                 this run has {} ranks: start it without mpirun, or set the surface tension to 0",
-                comm.size()
-            )));
         }
         self.default_domain();
         let rcb = Rcb::from_points(&self.fluid.pos, comm.size(), self.domain, self.periodic)
@@ -256,6 +258,7 @@ impl Simulation {
             peer_ranks,
             halo_vel: Vec::new(),
             halo_rho: Vec::new(),
+            halo_adh: Vec::new(),
             last_halo: 0,
             last_migrants: 0,
             rebalances: 0,
@@ -551,6 +554,57 @@ impl Simulation {
             }
         }
         self.gather_halo_state();
+    }
+
+    /// Sends `values` (one per owned particle) of the particles of the last halo exchange (same lists,
+    /// same order) and returns what arrives, by receive slot. Collective. For the quantities the owner
+    /// computes from its whole neighbourhood within a step: surface normals and wall adhesion.
+    fn halo_vec3(d: &Decomp, comm: &dyn Comm, values: &[Vec3]) -> Vec<Vec3> {
+        let out: Vec<Vec<u8>> = d
+            .send
+            .iter()
+            .map(|list| {
+                let mut w = WireWriter::with_capacity(24 * list.len());
+                for &(i, _) in list {
+                    w.vec3(values[i as usize]);
+                }
+                w.finish()
+            })
+            .collect();
+        let got = comm.neighbour_exchange(&d.peer_ranks, &out);
+        let mut v = Vec::with_capacity(d.halo_vel.len());
+        for buf in &got {
+            let mut r = WireReader::new(buf);
+            while !r.is_done() {
+                v.push(r.vec3().expect("halo message from another rank of this run"));
+            }
+        }
+        v
+    }
+
+    /// The surface normals of the halo particles, in image order (`g_src`), into `out`. Collective.
+    pub(super) fn halo_normals(&self, comm: &dyn Comm, nrm: &[Vec3], out: &mut Vec<Vec3>) {
+        let Some(d) = self.decomp.as_ref() else { return };
+        let by_slot = Self::halo_vec3(d, comm, nrm);
+        out.clear();
+        out.extend(self.work.g_src.iter().map(|&s| by_slot[s as usize]));
+    }
+
+    /// Exchanges the wall adhesion of the owned particles (`adh`) for that of the halo, kept by receive
+    /// slot. Collective.
+    pub(super) fn exchange_halo_adhesion(&mut self, comm: &dyn Comm, adh: &[Vec3]) {
+        let Some(d) = self.decomp.as_ref() else { return };
+        let by_slot = Self::halo_vec3(d, comm, adh);
+        if let Some(d) = self.decomp.as_mut() {
+            d.halo_adh = by_slot;
+        }
+    }
+
+    /// The wall adhesion of the halo particles from the last exchange, in image order, into `out`.
+    pub(super) fn halo_adhesion(&self, out: &mut Vec<Vec3>) {
+        let Some(d) = self.decomp.as_ref() else { return };
+        out.clear();
+        out.extend(self.work.g_src.iter().map(|&s| d.halo_adh[s as usize]));
     }
 
     /// Velocity, density, p/ρ² and 1/ρ of the halo particles from the received values, by the equation

@@ -432,7 +432,7 @@ impl Simulation {
             self.decompose(comm)?;
         }
         self.prepare_sets_with(comm);
-        let st = self.passes(0.0);
+        let st = self.passes_timed(0.0, &mut || 0.0, comm);
         // The wet flags of the start (weight 0: no wet time yet), so that a map or a series row at t = 0
         // shows the wetting of the liquid at rest rather than all walls dry.
         self.accumulate_wetting(0.0);
@@ -468,7 +468,7 @@ impl Simulation {
     pub fn refresh_with(&mut self, comm: &dyn Comm) {
         self.boundary.update_kinematics(&self.tree, self.time);
         self.prepare_sets_with(comm);
-        self.wall_state_only();
+        self.wall_state_with(Some(comm));
     }
 
     fn consts(&self, dt: f64) -> Consts {
@@ -842,6 +842,13 @@ impl Simulation {
     /// Wall extrapolation only (probes and loads between steps). The output buffers are moved out of
     /// `work` while the pass reads the views (no copy, no allocation).
     fn wall_state_only(&mut self) {
+        self.wall_state_with(None)
+    }
+
+    /// [`Self::wall_state_only`]; with `comm` on several ranks the wall adhesion of the halo particles
+    /// is exchanged first (collective), without it the last exchange's is used (the positions have not
+    /// moved since: sensors between steps).
+    fn wall_state_with(&mut self, comm: Option<&dyn Comm>) {
         let kernel = self.kernel();
         let c = self.consts(self.dt);
         let w = &mut self.work;
@@ -849,18 +856,25 @@ impl Simulation {
         let (mut rho, mut pr, mut irho) = (take(&mut w.w_rho), take(&mut w.w_pr), take(&mut w.w_irho));
         let (mut vvisc, mut wet) = (take(&mut w.w_vvisc), take(&mut w.w_wet));
         let (mut adh, mut g_adh) = (take(&mut w.adh), take(&mut w.g_adh));
-        let (fl, gh, wl) = self.views();
         // The walls push back on the liquid their adhesion pulls on, like on its weight.
         let adhesive = c.gamma_st > 0.0 && c.beta.iter().any(|&b| b != 0.0);
-        let (fl, gh) = if adhesive {
-            adh.resize(fl.pos.len(), Vec3::ZERO);
+        if adhesive {
+            adh.resize(self.fluid.len(), Vec3::ZERO);
+            let (fl, _, wl) = self.views();
             pass::adhesion(&c, fl, wl, &mut adh);
-            g_adh.clear();
-            g_adh.extend(self.work.g_src.iter().map(|&s| adh[s as usize]));
-            (FluidSet { adh: &adh, ..fl }, FluidSet { adh: &g_adh, ..gh })
-        } else {
-            (fl, gh)
-        };
+            if self.decomp.is_some() {
+                if let Some(comm) = comm {
+                    self.exchange_halo_adhesion(comm, &adh);
+                }
+                self.halo_adhesion(&mut g_adh);
+            } else {
+                g_adh.clear();
+                g_adh.extend(self.work.g_src.iter().map(|&s| adh[s as usize]));
+            }
+        }
+        let (fl, gh, wl) = self.views();
+        let (fl, gh) =
+            if adhesive { (FluidSet { adh: &adh, ..fl }, FluidSet { adh: &g_adh, ..gh }) } else { (fl, gh) };
         pass::wall_state(&kernel, &c, wl, fl, gh, &mut rho, &mut pr, &mut irho, &mut vvisc, &mut wet);
         let w = &mut self.work;
         (w.w_rho, w.w_pr, w.w_irho, w.w_vvisc, w.w_wet) = (rho, pr, irho, vvisc, wet);
@@ -877,15 +891,12 @@ impl Simulation {
         self.work.times
     }
 
-    fn passes(&mut self, dt: f64) -> PassStats {
-        self.passes_timed(dt, &mut || 0.0)
-    }
-
-    /// Wall state, surface normals and the fluid pass; results in `work.acc_new`, `work.drho_new`.
-    fn passes_timed(&mut self, dt: f64, lap: &mut dyn FnMut() -> f64) -> PassStats {
+    /// Wall state, surface normals and the fluid pass; results in `work.acc_new`, `work.drho_new`. On
+    /// several ranks the halo's wall adhesion and surface normals come from their owners (collective).
+    fn passes_timed(&mut self, dt: f64, lap: &mut dyn FnMut() -> f64, comm: &dyn Comm) -> PassStats {
         let kernel = self.kernel();
         let c = self.consts(dt);
-        self.wall_state_only();
+        self.wall_state_with(Some(comm));
         self.work.times.wall_state += lap();
         let n = self.fluid.len();
         let st_on = c.gamma_st > 0.0;
@@ -894,8 +905,12 @@ impl Simulation {
             nrm.resize(n, Vec3::ZERO);
             let (fl, gh, _) = self.views();
             pass::normals(&kernel, &c, fl, gh, &mut nrm);
-            g_nrm.clear();
-            g_nrm.extend(self.work.g_src.iter().map(|&s| nrm[s as usize]));
+            if self.decomp.is_some() {
+                self.halo_normals(comm, &nrm, &mut g_nrm);
+            } else {
+                g_nrm.clear();
+                g_nrm.extend(self.work.g_src.iter().map(|&s| nrm[s as usize]));
+            }
         }
         let w = &mut self.work;
         let (mut acc, mut drho, mut phi) = (take(&mut w.acc_new), take(&mut w.drho_new), take(&mut w.phi));
@@ -1001,7 +1016,7 @@ impl Simulation {
         // Forces at the new positions.
         self.prepare_sets();
         self.work.times.sort += lap();
-        let st = self.passes_timed(dt, &mut lap);
+        let st = self.passes_timed(dt, &mut lap, &SERIAL);
         self.accumulate_wetting(dt);
         self.correct(dt);
         self.time = t1;
