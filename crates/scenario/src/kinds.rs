@@ -87,7 +87,7 @@ kinds! {
         "Stick/bounce regime map of snow grains hitting a wall: grid, bisection, sensitivity study, rough wall.";
     "deposition" => Deposition(spatter_workflows::deposition::DepositionConfig, spatter_workflows::deposition::run), ranks = false,
         "Particles carried by an analytic or imported (VTK) flow onto STL bodies: deposit maps, mass balance.";
-    "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run), ranks = false,
+    "wading" => Wading(spatter_workflows::wading::WadingConfig, spatter_workflows::wading::run), ranks = true,
         "A vehicle of named STL parts driving through a wading channel (generated or from an STL file): wetting per part, sensors, splash heights.";
     "flow" => Flow(spatter_workflows::cfd::FlowConfig, spatter_workflows::cfd::run), ranks = false,
         "Incompressible flow on a structured grid (Cartesian with solids, or axisymmetric): fields, probes, pictures.";

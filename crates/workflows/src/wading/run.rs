@@ -394,6 +394,20 @@ fn write_text(path: &Path, text: &str) -> Result<(), WadingError> {
 
 /// The `sph` scene of the run, with its geometry and motion files written under `geo`.
 pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, WadingError> {
+    scene_with_files(cfg, plan, geo, true)
+}
+
+/// [`scene`]; the geometry and motion files are written only when `write` (on several ranks rank 0
+/// writes them and every rank reads them).
+fn scene_with_files(cfg: &WadingConfig, plan: &Plan, geo: &Path, write: bool) -> Result<SphConfig, WadingError> {
+    let write_text = |path: &Path, text: &str| if write { write_text(path, text) } else { Ok(()) };
+    let write_stl = |path: &Path, name: &str, mesh: &spatter_core::mesh::TriMesh| {
+        if write {
+            write_stl(path, name, mesh).map_err(io_err(path))
+        } else {
+            Ok(())
+        }
+    };
     let ch = &plan.channel;
     let dp = cfg.fluid.spacing_m;
     let wheels = &cfg.vehicle.wheels;
@@ -419,7 +433,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
     let layers = Some((2.0 * cfg.fluid.h_over_dp.unwrap_or(1.5)).ceil() as usize);
     for (name, mesh) in ch.surfaces() {
         let file = geo.join(format!("{name}.stl"));
-        write_stl(&file, &name, &mesh).map_err(io_err(&file))?;
+        write_stl(&file, &name, &mesh)?;
         walls.push(wall(&name, file, None, cfg.channel.adhesion, layers));
     }
     // The middle of the axles across the vehicle (its own frame), for the wheels' view side.
@@ -431,7 +445,7 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
         let mut mesh = part.mesh.clone();
         mesh.vertices.iter_mut().for_each(|v| *v = p0.apply(*v));
         let file = geo.join(format!("{}.stl", part.name));
-        write_stl(&file, &part.name, &mesh).map_err(io_err(&file))?;
+        write_stl(&file, &part.name, &mesh)?;
         let motion = match wheels.iter().find(|w| w.part == part.name) {
             Some(w) => {
                 let name = format!("spin_{}", part.name);
@@ -547,7 +561,18 @@ fn wall(
 pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingError> {
     let plan = plan(cfg)?;
     let geo = ctx.dir.path("geometry");
-    let scfg = scene(cfg, &plan, &geo)?;
+    // On several ranks rank 0 writes the geometry and every rank reads it: all wait until it is written,
+    // and a rank 0 that failed to write ends every rank.
+    let comm = ctx.comm;
+    let scfg = scene_with_files(cfg, &plan, &geo, comm.is_root());
+    if comm.size() > 1 {
+        let mut failed = [u64::from(scfg.is_err())];
+        comm.all_sum_u64(&mut failed);
+        if failed[0] > 0 && scfg.is_ok() {
+            return Err(WadingError::Io("rank 0 could not write the geometry files (its error ends the run)".into()));
+        }
+    }
+    let scfg = scfg?;
     tracing::info!(
         "wading: {} parts, front axle from x = {:.3} m, water reached at t = {:.3} s, end at t = {:.3} s (front axle at x = {:.3} m)",
         plan.parts.len(),
@@ -557,7 +582,8 @@ pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingErr
         plan.travel.front(plan.t_end).0
     );
     let mut summary = crate::sph_scene::run(&scfg, ctx)?;
-    if summary.finished != Finished::Completed {
+    // Rank 0 wrote the results; the reports read them.
+    if summary.finished != Finished::Completed || !comm.is_root() {
         return Ok(summary);
     }
     report(cfg, &plan, ctx, &mut summary)?;
