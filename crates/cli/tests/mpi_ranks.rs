@@ -142,6 +142,19 @@ fn assert_series_close(a: &Path, b: &Path, what: &str) {
     }
 }
 
+/// Runs `scenario` with `extra` arguments and `--threads 1` plainly into `dir/plain` and on two ranks
+/// into `dir/mpirun2`, both to success; returns the two run folders.
+fn plain_and_two_ranks(dir: &Path, scenario: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let (a, b) = (dir.join("plain"), dir.join("mpirun2"));
+    for (out, ranks) in [(&a, 1), (&b, 2)] {
+        let mut args = vec!["run", scenario, "--threads", "1", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = if ranks == 1 { plain(&args) } else { mpirun(ranks, &args) };
+        assert!(o.status.success(), "{ranks} rank(s): {}", String::from_utf8_lossy(&o.stderr));
+    }
+    (a, b)
+}
+
 /// The 3D dam break (`--smoke`) on two ranks against a plain run: every `series.csv` column within 10⁻⁶
 /// of its scale (the largest magnitude of the column, or of the force or moment vector it belongs to):
 /// pairs across the rank cut are evaluated in double precision, the others in single precision, so the
@@ -151,16 +164,7 @@ fn assert_series_close(a: &Path, b: &Path, what: &str) {
 fn two_ranks_match_one_rank() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = example("sph_dam_break.toml");
-    let scenario = scenario.to_str().unwrap();
-    let (a, b) = (tmp.path().join("plain"), tmp.path().join("mpirun2"));
-    let args = |out: &Path| {
-        ["run", scenario, "--smoke", "--threads", "1", "--out", out.to_str().unwrap()].map(String::from)
-    };
-    let (ra, rb) = (args(&a), args(&b));
-    let pa = plain(&ra.each_ref().map(String::as_str));
-    assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
-    let pb = mpirun(2, &rb.each_ref().map(String::as_str));
-    assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
+    let (a, b) = plain_and_two_ranks(tmp.path(), scenario.to_str().unwrap(), &["--smoke"]);
     assert_series_close(&a, &b, "two ranks against one");
     let pvtu = std::fs::read_to_string(b.join("particles/particles_00001.pvtu")).unwrap();
     assert!(pvtu.contains("particles_00001_r0000.vtu") && pvtu.contains("particles_00001_r0001.vtu"));
@@ -191,15 +195,7 @@ fn rebalancing_on_two_ranks_matches_one_rank() {
         .replace("vtu_interval_s = 0.02", "vtu_interval_s = 0.05")
         + "\n[domain]\nrebalance_imbalance = 1.0\n";
     let scenario = common::write(tmp.path(), "dam.toml", text.as_bytes());
-    let scenario = scenario.to_str().unwrap();
-    let (a, b) = (tmp.path().join("plain"), tmp.path().join("mpirun2"));
-    let args =
-        |out: &Path| ["run", scenario, "--threads", "1", "--out", out.to_str().unwrap()].map(String::from);
-    let (ra, rb) = (args(&a), args(&b));
-    let pa = plain(&ra.each_ref().map(String::as_str));
-    assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
-    let pb = mpirun(2, &rb.each_ref().map(String::as_str));
-    assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
+    let (a, b) = plain_and_two_ranks(tmp.path(), scenario.to_str().unwrap(), &[]);
     let log = std::fs::read_to_string(b.join("log.txt")).unwrap();
     let line = log.lines().find(|l| l.contains("load balance:")).expect("the log reports the load balance");
     let count: usize = line
@@ -222,16 +218,7 @@ fn rebalancing_on_two_ranks_matches_one_rank() {
 fn wading_on_two_ranks_matches_one_rank() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = example("wading_truck.toml");
-    let scenario = scenario.to_str().unwrap();
-    let (a, b) = (tmp.path().join("plain"), tmp.path().join("mpirun2"));
-    let args = |out: &Path| {
-        ["run", scenario, "--smoke", "--threads", "1", "--out", out.to_str().unwrap()].map(String::from)
-    };
-    let (ra, rb) = (args(&a), args(&b));
-    let pa = plain(&ra.each_ref().map(String::as_str));
-    assert!(pa.status.success(), "{}", String::from_utf8_lossy(&pa.stderr));
-    let pb = mpirun(2, &rb.each_ref().map(String::as_str));
-    assert!(pb.status.success(), "{}", String::from_utf8_lossy(&pb.stderr));
+    let (a, b) = plain_and_two_ranks(tmp.path(), scenario.to_str().unwrap(), &["--smoke"]);
     assert_series_close(&a, &b, "wading on two ranks against one");
     for file in ["wetting.csv", "sensors.csv", "splash_height.csv", "wetting_groups.csv"] {
         let (cols, x) = read_csv(&a.join(file));
