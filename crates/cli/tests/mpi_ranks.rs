@@ -303,6 +303,38 @@ fn two_ranks_resume_on_two_and_on_one() {
     assert_eq!(err.matches("it needs --resume").count(), 1, "{err}");
 }
 
+/// A wading run on two ranks stopped at a checkpoint and resumed on two ranks writes every file byte
+/// for byte as the uninterrupted two-rank run (the example truck, `--smoke`): the scene's state, the
+/// wetting records and the reports rank 0 writes from them.
+#[test]
+fn wading_on_two_ranks_resumes_bit_for_bit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = example("wading_truck.toml");
+    let run = |out: &Path, extra: &[&str]| {
+        let mut a = vec![
+            "run",
+            scenario.to_str().unwrap(),
+            "--smoke",
+            "--threads",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let (whole, split) = (tmp.path().join("whole"), tmp.path().join("split"));
+    let o = mpirun(2, &strs(&run(&whole, &[])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let envs = [("SPATTER_STOP_AFTER_POLLS", "3")];
+    let o = mpirun_env(2, &strs(&run(&split, &["--checkpoint-interval-s", "1e-9"])), &envs);
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(split.join("checkpoint").read_dir().unwrap().count() == 2, "one part per rank");
+    let o = mpirun(2, &strs(&run(&split, &["--resume"])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_same_files(&whole, &split, "wading on two ranks against two ranks stopped and resumed on two");
+}
+
 /// An `mpirun` started by a test: killed with its ranks when the test ends before it does (a failed
 /// assertion, a hang), so that no rank outlives the test.
 struct Job(std::process::Child);
