@@ -770,6 +770,18 @@ impl Simulation {
         w
     }
 
+    /// [`crate::wetting::part_water`] over the ranks of `comm` (each rank's own fluid, summed in rank
+    /// order). Collective.
+    pub fn part_water_with(&self, comm: &dyn Comm, k: usize) -> crate::wetting::PartWater {
+        let mut w = crate::wetting::part_water(self, k);
+        if self.decomp.is_some() {
+            let mut v = [w.volume, w.arrival];
+            comm.sum_f64_ordered(&mut v);
+            (w.volume, w.arrival) = (v[0], v[1]);
+        }
+        w
+    }
+
     /// The wet flag and total wet time \[s\] of every wall particle, gathered from the ranks that hold
     /// them (collective); on one rank the boundary's own arrays.
     pub fn wetting_with(&self, comm: &dyn Comm) -> (Vec<bool>, Vec<f64>) {

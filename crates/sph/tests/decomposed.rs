@@ -542,7 +542,8 @@ fn surface_tension_and_adhesion_on_1_2_4_ranks() {
 }
 
 /// Sensors and totals on 1, 2 and 4 ranks after 200 steps of the dam break: kinetic energy, momentum,
-/// mass, the tank's load, a probe in the column and a wall-pressure sensor on the back wall. Collective
+/// mass, the tank's load, a probe in the column, a wall-pressure sensor on the back wall and the water at
+/// the tank and its arrival rate (`part_water_with`; measured: 2·10⁻¹¹ and 2·10⁻⁸ relative). Collective
 /// forms (`*_with`) agree with the one-rank plain methods within 10⁻⁶ relative, about ten single-precision
 /// epsilons (the runs differ at the single-precision rounding of cut pairs, see
 /// `dam_break_2d_on_1_2_4_ranks`; measured: up to 3·10⁻⁸ for the wall pressure, 10⁻¹⁰ for the energy); the
@@ -568,6 +569,7 @@ fn sensors_agree_across_rank_counts() {
             let dry = sim.wall_pressure_with(comm, Vec3::new(-0.0025, 0.0, 0.19), 0.08).unwrap();
             let m = sim.momentum_with(comm);
             let wet = sim.wet_area_with(comm, 0, sim.time);
+            let water = sim.part_water_with(comm, 0);
             [
                 sim.kinetic_energy_with(comm),
                 m.x,
@@ -582,6 +584,8 @@ fn sensors_agree_across_rank_counts() {
                 wet.wet_now,
                 wet.wet_mean,
                 dry,
+                water.volume,
+                water.arrival,
             ]
         })
         .remove(0)
@@ -589,10 +593,11 @@ fn sensors_agree_across_rank_counts() {
     let one = sensors(1);
     let names = [
         "E_kin", "P_x", "P_z", "mass", "F_x", "F_z", "p_probe", "u_probe", "w_probe", "p_wall", "wet_now",
-        "wet_mean", "p_top",
+        "wet_mean", "p_top", "water", "arrival",
     ];
     assert!(one[9] > 500.0, "the back-wall sensor is under water: {} Pa", one[9]);
     assert!(one[12] > 0.0, "the top sensor reaches wet wall particles: {} Pa", one[12]);
+    assert!(one[13] > 0.0 && one[14] > 0.0, "water at the tank, arriving: {} m², {} m²/s", one[13], one[14]);
     for n in [2, 4] {
         let got = sensors(n);
         assert_eq!(got[3], one[3], "mass is exact");

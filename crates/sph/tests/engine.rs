@@ -285,3 +285,30 @@ fn wet_fraction_under_a_falling_stream_converges_with_the_spacing() {
     assert!(d2 < d1, "change 8→4 mm {d1} m, 4→2 mm {d2} m: not converging");
     assert!(d2 < 0.05 * l[2], "change 4→2 mm {d2} m against {} m", l[2]);
 }
+
+/// The water at a wall and the rate it arrives (`part_water`), against a count of the lattice: a 2D block
+/// of water 10 × 10 spacings, at rest density without gravity, against the left wall of a tank and two
+/// spacings above its floor, moving at U = 0.5 m/s, with a wet reach of 1.2 dp (set here so that no
+/// particle lies on the reach). Only the block's first column lies within it (0.5 dp from the wall's
+/// surface; the next column 1.5 dp, the floor 2.5 dp away), so the water is 10 dp² (per metre of depth)
+/// and, towards the wall, it arrives at 10 dp² · U / (1.2 dp); moving away, at 0. Read before the first
+/// step (the state as set up), to round-off.
+#[test]
+fn water_at_a_wall_and_its_arrival_rate_match_the_lattice() {
+    let dp = 0.01;
+    let u = 0.5;
+    for (dir, arriving) in [(-1.0, true), (1.0, false)] {
+        let mut p = SphParams::water(Dim::Two, dp, 10.0);
+        p.gravity = Vec3::ZERO;
+        p.wet_distance = 1.2 * dp;
+        let mut sim = in_open_tank(p, Vec3::new(0.3, 0.0, 0.3));
+        let block = Aabb::new(Vec3::new(0.0, 0.0, 2.0 * dp), Vec3::new(10.0 * dp, 0.0, 12.0 * dp));
+        assert_eq!(sim.fill_box(block, Vec3::new(dir * u, 0.0, 0.0), false), 100);
+        sim.initialize().unwrap();
+        let w = spatter_sph::wetting::part_water(&sim, 0);
+        let volume = 10.0 * dp * dp;
+        let arrival = if arriving { volume * u / (1.2 * dp) } else { 0.0 };
+        assert!((w.volume - volume).abs() <= 1e-12, "water {} m² against {volume} m²", w.volume);
+        assert!((w.arrival - arrival).abs() <= 1e-12, "arrival {} m²/s against {arrival} m²/s", w.arrival);
+    }
+}

@@ -149,7 +149,17 @@ fn series_columns(cfg: &SphConfig, sim: &Simulation) -> Vec<String> {
     .map(|s| s.to_string())
     .collect();
     for p in &sim.boundary.parts {
-        for q in ["Fx_N", "Fy_N", "Fz_N", "Mx_Nm", "My_Nm", "Mz_Nm", "wet_area_m2"] {
+        for q in [
+            "Fx_N",
+            "Fy_N",
+            "Fz_N",
+            "Mx_Nm",
+            "My_Nm",
+            "Mz_Nm",
+            "wet_area_m2",
+            "water_m3",
+            "water_arrival_m3_s",
+        ] {
             c.push(format!("{}_{q}", p.name));
         }
     }
@@ -188,8 +198,20 @@ fn series_row(cfg: &SphConfig, sim: &mut Simulation, comm: &dyn Comm) -> Vec<Opt
     let loads = sim.part_loads_with(comm);
     for (k, ld) in loads.iter().enumerate() {
         let wa = sim.wet_area_with(comm, k, sim.time);
+        let water = sim.part_water_with(comm, k);
         r.extend(
-            [ld.force.x, ld.force.y, ld.force.z, ld.torque.x, ld.torque.y, ld.torque.z, wa.wet_now].map(Some),
+            [
+                ld.force.x,
+                ld.force.y,
+                ld.force.z,
+                ld.torque.x,
+                ld.torque.y,
+                ld.torque.z,
+                wa.wet_now,
+                water.volume,
+                water.arrival,
+            ]
+            .map(Some),
         );
     }
     for p in &cfg.sensors.probes {

@@ -647,62 +647,9 @@ fn report(
     )
     .map_err(io_err(&gpath))?;
     summary.artifacts.push(("wetting per group".into(), gpath));
-    // Sensor series: wet fraction over time from series.csv.
+    // Sensor series from series.csv: wet fraction, water at the patch and its arrival rate over time.
     if !plan.sensors.is_empty() {
-        let spath = dir.path("series.csv");
-        let text = std::fs::read_to_string(&spath).map_err(io_err(&spath))?;
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
-        let mut cols = Vec::new();
-        for (k, s) in plan.sensors.iter().enumerate() {
-            let col = header.iter().position(|h| *h == format!("{s}_wet_area_m2"));
-            let a = area.iter().find(|(n, _, _)| n == s).map(|e| e.1);
-            if let (Some(c), Some(a)) = (col, a) {
-                cols.push((s.clone(), c, a.max(f64::MIN_POSITIVE)));
-            } else {
-                return Err(WadingError::Io(format!(
-                    "{}: no column {s}_wet_area_m2 for sensors[{k}] (or no area in wetting.csv)",
-                    spath.display()
-                )));
-            }
-        }
-        let mut rows = Vec::new();
-        let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); cols.len()];
-        for line in lines {
-            let f: Vec<&str> = line.split(',').collect();
-            let t: f64 = f.first().and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
-            let mut row = vec![spatter_io::fmt_f64(t)];
-            for (j, (_, c, a)) in cols.iter().enumerate() {
-                let w: f64 = f.get(*c).and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
-                row.push(spatter_io::fmt_f64(w / a));
-                curves[j].push((t, w / a));
-            }
-            rows.push(row);
-        }
-        let mut head = vec!["t_s".to_owned()];
-        head.extend(cols.iter().map(|(s, _, _)| format!("{s}_wet_fraction")));
-        let head: Vec<&str> = head.iter().map(String::as_str).collect();
-        let p = dir.path("sensors.csv");
-        spatter_io::csv::write_table(&p, &head, &rows).map_err(io_err(&p))?;
-        for (name, _, _) in &cols {
-            summary.curves.push(CurveRecord {
-                label: format!("{name} wet fraction over time"),
-                csv: p.clone(),
-                x_column: "t_s".into(),
-                y_column: format!("{name}_wet_fraction"),
-                x_label: "time [s]".into(),
-                y_label: format!("wet fraction of {name}"),
-            });
-        }
-        summary.artifacts.push(("sensor wet fractions".into(), p));
-        let mut chart =
-            spatter_io::plot::Chart::new("Sensor patches", "time [s]", "wet fraction of the patch");
-        for ((s, _, _), pts) in cols.iter().zip(&curves) {
-            chart = chart.line(s, pts);
-        }
-        let png = dir.path("sensors.png");
-        chart.save_png(&png).map_err(io_err(&png))?;
-        summary.artifacts.push(("sensor plot".into(), png));
+        sensor_series(plan, dir, &area, summary)?;
     }
     // Which instantaneous map is which vehicle position.
     if !plan.map_times.is_empty() {
@@ -770,6 +717,99 @@ fn report(
             cfg.channel.water_depth_m
         ),
     );
+    Ok(())
+}
+
+/// What `sensors.csv` holds per sensor: the column of `series.csv` it comes from, the divisor (the
+/// sensor's area for the wet fraction), the name of its column, the axis label and the plot file.
+const SENSOR_QUANTITIES: [(&str, bool, &str, &str, &str); 3] = [
+    ("wet_area_m2", true, "wet_fraction", "wet fraction of the patch", "sensors.png"),
+    ("water_m3", false, "water_m3", "water at the patch [m³]", "sensors_water.png"),
+    (
+        "water_arrival_m3_s",
+        false,
+        "water_arrival_m3_s",
+        "water arriving at the patch [m³/s]",
+        "sensors_arrival.png",
+    ),
+];
+
+/// `sensors.csv` and its plots: per sensor part its wet fraction, the water within its wet reach and the
+/// rate at which water arrives there (series.csv's `<part>_wet_area_m2`, `_water_m3`,
+/// `_water_arrival_m3_s`; docs/wading.md, "Results").
+fn sensor_series(
+    plan: &Plan,
+    dir: &spatter_io::run::RunDir,
+    area: &[(String, f64, f64)],
+    summary: &mut RunSummary,
+) -> Result<(), WadingError> {
+    let spath = dir.path("series.csv");
+    let text = std::fs::read_to_string(&spath).map_err(io_err(&spath))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
+    // Per quantity and sensor: (sensor, series column, divisor).
+    let mut cols: Vec<Vec<(String, usize, f64)>> = Vec::new();
+    for (source, per_area, ..) in SENSOR_QUANTITIES {
+        let mut q = Vec::new();
+        for (k, s) in plan.sensors.iter().enumerate() {
+            let col = header.iter().position(|h| *h == format!("{s}_{source}"));
+            let a = area.iter().find(|(n, _, _)| n == s).map(|e| e.1);
+            match (col, a) {
+                (Some(c), Some(a)) => {
+                    q.push((s.clone(), c, if per_area { a.max(f64::MIN_POSITIVE) } else { 1.0 }))
+                }
+                _ => {
+                    return Err(WadingError::Io(format!(
+                        "{}: no column {s}_{source} for sensors[{k}] (or no area in wetting.csv)",
+                        spath.display()
+                    )))
+                }
+            }
+        }
+        cols.push(q);
+    }
+    let mut rows = Vec::new();
+    let mut curves: Vec<Vec<Vec<(f64, f64)>>> = cols.iter().map(|q| vec![Vec::new(); q.len()]).collect();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let t: f64 = f.first().and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
+        let mut row = vec![spatter_io::fmt_f64(t)];
+        for (q, c) in cols.iter().zip(curves.iter_mut()) {
+            for ((_, col, div), pts) in q.iter().zip(c.iter_mut()) {
+                let v: f64 = f.get(*col).and_then(|s| s.trim().parse().ok()).unwrap_or(f64::NAN);
+                row.push(spatter_io::fmt_f64(v / div));
+                pts.push((t, v / div));
+            }
+        }
+        rows.push(row);
+    }
+    let mut head = vec!["t_s".to_owned()];
+    for ((.., name, _, _), q) in SENSOR_QUANTITIES.iter().zip(&cols) {
+        head.extend(q.iter().map(|(s, _, _)| format!("{s}_{name}")));
+    }
+    let head_ref: Vec<&str> = head.iter().map(String::as_str).collect();
+    let p = dir.path("sensors.csv");
+    spatter_io::csv::write_table(&p, &head_ref, &rows).map_err(io_err(&p))?;
+    for ((_, _, name, label, file), (q, c)) in SENSOR_QUANTITIES.iter().zip(cols.iter().zip(&curves)) {
+        for (s, _, _) in q {
+            summary.curves.push(CurveRecord {
+                label: format!("{s}: {label} over time"),
+                csv: p.clone(),
+                x_column: "t_s".into(),
+                y_column: format!("{s}_{name}"),
+                x_label: "time [s]".into(),
+                y_label: format!("{label}, {s}"),
+            });
+        }
+        let mut chart = spatter_io::plot::Chart::new("Sensor patches", "time [s]", label);
+        for ((s, _, _), pts) in q.iter().zip(c) {
+            chart = chart.line(s, pts);
+        }
+        let png = dir.path(file);
+        chart.save_png(&png).map_err(io_err(&png))?;
+        summary.artifacts.push((format!("sensor plot: {label}"), png));
+    }
+    summary.artifacts.push(("sensor series (wet fraction, water, arrival rate)".into(), p));
     Ok(())
 }
 
