@@ -962,6 +962,35 @@ pub(crate) mod tests {
         assert!(e.starts_with("sensor_boxes[0].part: part = \"fl\" is a wheel"), "{e}");
     }
 
+    /// `sensors.csv` from a scene's `series.csv`: per sensor its wet area over its area (from
+    /// `wetting.csv`), the water at it and its arrival rate as written; a sensor without its columns is
+    /// named. Hand-made tables: sensor `fl` of area 2 m² (wet 0.5 m² at t = 0.1 s: 25 %).
+    #[test]
+    fn the_sensor_table_holds_wet_fraction_water_and_arrival() {
+        let dir = tempfile::tempdir().unwrap();
+        let cfg = config(dir.path());
+        let plan = plan(&cfg).unwrap();
+        assert_eq!(plan.sensors, vec!["fl".to_owned()]);
+        let rd = spatter_io::run::RunDir::create(&dir.path().join("run")).unwrap();
+        let series =
+            "t_s,fl_Fx_N,fl_wet_area_m2,fl_water_m3,fl_water_arrival_m3_s\n0,1,0,0,0\n0.1,2,0.5,0.003,0.02\n";
+        std::fs::write(rd.path("series.csv"), series).unwrap();
+        let area = vec![("fl".to_owned(), 2.0, 0.1)];
+        let mut summary = RunSummary::new(Finished::Completed);
+        sensor_series(&plan, &rd, &area, &mut summary).unwrap();
+        let text = std::fs::read_to_string(rd.path("sensors.csv")).unwrap();
+        let rows: Vec<&str> = text.lines().collect();
+        assert_eq!(rows[0], "t_s,fl_wet_fraction,fl_water_m3,fl_water_arrival_m3_s");
+        let last: Vec<f64> = rows[2].split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(last, vec![0.1, 0.25, 0.003, 0.02]);
+        for png in ["sensors.png", "sensors_water.png", "sensors_arrival.png"] {
+            assert!(rd.path(png).is_file(), "{png}");
+        }
+        std::fs::write(rd.path("series.csv"), "t_s,fl_wet_area_m2\n0,0\n").unwrap();
+        let e = sensor_series(&plan, &rd, &area, &mut summary).unwrap_err().to_string();
+        assert!(e.contains("no column fl_water_m3 for sensors[0]"), "{e}");
+    }
+
     /// Rows `t v ω` of a motion table's text.
     fn table_rows(path: &Path) -> Vec<Vec<f64>> {
         let text = std::fs::read_to_string(path).unwrap();
