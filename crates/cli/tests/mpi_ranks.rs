@@ -305,7 +305,8 @@ fn two_ranks_resume_on_two_and_on_one() {
 
 /// A wading run on two ranks stopped at a checkpoint and resumed on two ranks writes every file byte
 /// for byte as the uninterrupted two-rank run (the example truck, `--smoke`): the scene's state, the
-/// wetting records and the reports rank 0 writes from them.
+/// wetting records and the reports rank 0 writes from them. Resumed on one rank with `--repartition`,
+/// its `series.csv` agrees with the two-rank run as a one-rank run does.
 #[test]
 fn wading_on_two_ranks_resumes_bit_for_bit() {
     let tmp = tempfile::tempdir().unwrap();
@@ -326,13 +327,20 @@ fn wading_on_two_ranks_resumes_bit_for_bit() {
     let (whole, split) = (tmp.path().join("whole"), tmp.path().join("split"));
     let o = mpirun(2, &strs(&run(&whole, &[])));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let one = tmp.path().join("one");
     let envs = [("SPATTER_STOP_AFTER_POLLS", "3")];
-    let o = mpirun_env(2, &strs(&run(&split, &["--checkpoint-interval-s", "1e-9"])), &envs);
-    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(split.join("checkpoint").read_dir().unwrap().count() == 2, "one part per rank");
+    for dir in [&split, &one] {
+        let o = mpirun_env(2, &strs(&run(dir, &["--checkpoint-interval-s", "1e-9"])), &envs);
+        assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(dir.join("checkpoint").read_dir().unwrap().count() == 2, "one part per rank");
+    }
     let o = mpirun(2, &strs(&run(&split, &["--resume"])));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_same_files(&whole, &split, "wading on two ranks against two ranks stopped and resumed on two");
+    // On another rank count: within the tolerance of `two_ranks_match_one_rank`.
+    let o = mpirun(1, &strs(&run(&one, &["--resume", "--repartition"])));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_series_close(&whole, &one, "wading on two ranks against two resumed on one");
 }
 
 /// An `mpirun` started by a test: killed with its ranks when the test ends before it does (a failed
