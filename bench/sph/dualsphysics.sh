@@ -76,7 +76,9 @@ if [ ! -x "$solver" ]; then
     src="$dsph/build-$short/tree"
     rm -rf "$src"
     mkdir -p "$src"
-    g archive "$commit" src/source | tar -x -C "$src"
+    # (A snapshot without some large binaries makes git name them on stderr; the sources are complete.)
+    g archive "$commit" src/source 2>"$dsph/build-$short/archive.log" | tar -x -C "$src" ||
+        { cat "$dsph/build-$short/archive.log" >&2; die "cannot read src/source at $short"; }
     echo "building DualSPHysics's CPU solver ($short) in $dsph/build-$short (log: build.log) ..."
     make -C "$src/src/source" -f Makefile_cpu -j"$jobs" COMPILE_CHRONO=NO COMPILE_WAVEGEN=NO \
         COMPILE_MOORDYNPLUS=NO EXECS_DIRECTORY="$dsph/build-$short" EXECNAME=DualSPHysicsCPU \
