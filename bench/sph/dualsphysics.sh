@@ -4,7 +4,7 @@
 # the wall time to simulate the same physical time, with their ratios.
 #
 #   nice -n 10 bench/sph/dualsphysics.sh                    # about 2*10^5 fluid particles, T = 3 ms
-#   N=1000000 T=0.003 nice -n 10 bench/sph/dualsphysics.sh  # the full case
+#   N=1000000 T=0.001 nice -n 10 bench/sph/dualsphysics.sh  # the full case (23 steps, about 11 minutes)
 #
 # Environment:
 #   N          fluid particles wanted (default 200000); the spacing is dp = (0.4 * 0.67 * 0.3 m^3 / N)^(1/3),
