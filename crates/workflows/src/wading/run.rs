@@ -399,7 +399,12 @@ pub fn scene(cfg: &WadingConfig, plan: &Plan, geo: &Path) -> Result<SphConfig, W
 
 /// [`scene`]; the geometry and motion files are written only when `write` (on several ranks rank 0
 /// writes them and every rank reads them).
-fn scene_with_files(cfg: &WadingConfig, plan: &Plan, geo: &Path, write: bool) -> Result<SphConfig, WadingError> {
+fn scene_with_files(
+    cfg: &WadingConfig,
+    plan: &Plan,
+    geo: &Path,
+    write: bool,
+) -> Result<SphConfig, WadingError> {
     let write_text = |path: &Path, text: &str| if write { write_text(path, text) } else { Ok(()) };
     let write_stl = |path: &Path, name: &str, mesh: &spatter_core::mesh::TriMesh| {
         if write {
@@ -569,7 +574,9 @@ pub fn run(cfg: &WadingConfig, ctx: &RunContext) -> Result<RunSummary, WadingErr
         let mut failed = [u64::from(scfg.is_err())];
         comm.all_sum_u64(&mut failed);
         if failed[0] > 0 && scfg.is_ok() {
-            return Err(WadingError::Io("rank 0 could not write the geometry files (its error ends the run)".into()));
+            return Err(WadingError::Io(
+                "rank 0 could not write the geometry files (its error ends the run)".into(),
+            ));
         }
     }
     let scfg = scfg?;
