@@ -1,7 +1,8 @@
 //! Weakly compressible SPH engine for free-surface water with moving rigid bodies, surface tension,
 //! adhesion, air drag, wetting and splash sensors.
 //!
-//! * [`bench`] — the `spatter bench sph` dam break;
+//! * [`bench`] — the `spatter bench sph` dam break; [`bench_dsph`] — DualSPHysics's 01_DamBreak, timed to a
+//!   physical end time for the side-by-side run;
 //! * [`kernel`], [`eos`], [`params`] — kernels (Wendland C2, cubic spline, Akinci splines), Tait equation
 //!   of state, physical and numerical parameters;
 //! * [`fluid`], [`boundary`] — particle storage; walls sampled from boxes and meshes, moving by
@@ -19,6 +20,7 @@
 //! See `docs/sph.md` for the equations, defaults and references.
 
 pub mod bench;
+pub mod bench_dsph;
 pub mod boundary;
 mod candidates;
 pub mod drag;
