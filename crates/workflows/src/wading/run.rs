@@ -720,18 +720,50 @@ fn report(
     Ok(())
 }
 
-/// What `sensors.csv` holds per sensor: the column of `series.csv` it comes from, the divisor (the
-/// sensor's area for the wet fraction), the name of its column, the axis label and the plot file.
-const SENSOR_QUANTITIES: [(&str, bool, &str, &str, &str); 3] = [
-    ("wet_area_m2", true, "wet_fraction", "wet fraction of the patch", "sensors.png"),
-    ("water_m3", false, "water_m3", "water at the patch [m³]", "sensors_water.png"),
-    (
-        "water_arrival_m3_s",
-        false,
-        "water_arrival_m3_s",
-        "water arriving at the patch [m³/s]",
-        "sensors_arrival.png",
-    ),
+/// What `sensors.csv` holds per sensor, one quantity each.
+struct SensorQuantity {
+    /// Column of `series.csv` it comes from (after `<part>_`).
+    source: &'static str,
+    /// Divided by the sensor's area (the wet fraction).
+    per_area: bool,
+    /// Its column in `sensors.csv` (after `<sensor>_`).
+    column: &'static str,
+    /// Its curve in the summary: "<sensor> <phrase> over time", y axis "<of> <sensor>".
+    phrase: &'static str,
+    of: &'static str,
+    /// The plot's y axis and file.
+    axis: &'static str,
+    png: &'static str,
+}
+
+const SENSOR_QUANTITIES: [SensorQuantity; 3] = [
+    SensorQuantity {
+        source: "wet_area_m2",
+        per_area: true,
+        column: "wet_fraction",
+        phrase: "wet fraction",
+        of: "wet fraction of",
+        axis: "wet fraction of the patch",
+        png: "sensors.png",
+    },
+    SensorQuantity {
+        source: "water_m3",
+        per_area: false,
+        column: "water_m3",
+        phrase: "water",
+        of: "water [m³] at",
+        axis: "water at the patch [m³]",
+        png: "sensors_water.png",
+    },
+    SensorQuantity {
+        source: "water_arrival_m3_s",
+        per_area: false,
+        column: "water_arrival_m3_s",
+        phrase: "water arrival rate",
+        of: "water arriving [m³/s] at",
+        axis: "water arriving at the patch [m³/s]",
+        png: "sensors_arrival.png",
+    },
 ];
 
 /// `sensors.csv` and its plots: per sensor part its wet fraction, the water within its wet reach and the
@@ -749,7 +781,7 @@ fn sensor_series(
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
     // Per quantity and sensor: (sensor, series column, divisor).
     let mut cols: Vec<Vec<(String, usize, f64)>> = Vec::new();
-    for (source, per_area, ..) in SENSOR_QUANTITIES {
+    for SensorQuantity { source, per_area, .. } in SENSOR_QUANTITIES {
         let mut q = Vec::new();
         for (k, s) in plan.sensors.iter().enumerate() {
             let col = header.iter().position(|h| *h == format!("{s}_{source}"));
@@ -784,30 +816,30 @@ fn sensor_series(
         rows.push(row);
     }
     let mut head = vec!["t_s".to_owned()];
-    for ((.., name, _, _), q) in SENSOR_QUANTITIES.iter().zip(&cols) {
-        head.extend(q.iter().map(|(s, _, _)| format!("{s}_{name}")));
+    for (sq, q) in SENSOR_QUANTITIES.iter().zip(&cols) {
+        head.extend(q.iter().map(|(s, _, _)| format!("{s}_{}", sq.column)));
     }
     let head_ref: Vec<&str> = head.iter().map(String::as_str).collect();
     let p = dir.path("sensors.csv");
     spatter_io::csv::write_table(&p, &head_ref, &rows).map_err(io_err(&p))?;
-    for ((_, _, name, label, file), (q, c)) in SENSOR_QUANTITIES.iter().zip(cols.iter().zip(&curves)) {
+    for (sq, (q, c)) in SENSOR_QUANTITIES.iter().zip(cols.iter().zip(&curves)) {
         for (s, _, _) in q {
             summary.curves.push(CurveRecord {
-                label: format!("{s}: {label} over time"),
+                label: format!("{s} {} over time", sq.phrase),
                 csv: p.clone(),
                 x_column: "t_s".into(),
-                y_column: format!("{s}_{name}"),
+                y_column: format!("{s}_{}", sq.column),
                 x_label: "time [s]".into(),
-                y_label: format!("{label}, {s}"),
+                y_label: format!("{} {s}", sq.of),
             });
         }
-        let mut chart = spatter_io::plot::Chart::new("Sensor patches", "time [s]", label);
+        let mut chart = spatter_io::plot::Chart::new("Sensor patches", "time [s]", sq.axis);
         for ((s, _, _), pts) in q.iter().zip(c) {
             chart = chart.line(s, pts);
         }
-        let png = dir.path(file);
+        let png = dir.path(sq.png);
         chart.save_png(&png).map_err(io_err(&png))?;
-        summary.artifacts.push((format!("sensor plot: {label}"), png));
+        summary.artifacts.push((format!("sensor plot: {}", sq.axis), png));
     }
     summary.artifacts.push(("sensor series (wet fraction, water, arrival rate)".into(), p));
     Ok(())
