@@ -4,6 +4,7 @@ use crate::clump::NO_BODY;
 use crate::contact::ContactLaw;
 use crate::sim::{EnergyReport, Simulation};
 use crate::walls::{WallKinematics, WallShape};
+use spatter_core::comm::{Comm, WireReader, WireWriter};
 use spatter_core::Vec3;
 use spatter_io::vtu::Vtu;
 use std::io;
@@ -92,6 +93,32 @@ pub const BODY_COLUMNS: &[&str] = &[
     "t_s", "id", "template", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz", "vx_m_s", "vy_m_s", "vz_m_s",
     "wx_rad_s", "wy_rad_s", "wz_rad_s",
 ];
+
+/// [`body_rows`] of every rank, in id order (collective on a run split over ranks, where each rank holds
+/// the bodies whose centre is in its box; the plain rows otherwise, whose body order is the id order).
+pub fn body_rows_with<L: ContactLaw>(sim: &Simulation<L>, comm: &dyn Comm) -> Vec<Vec<f64>> {
+    let rows = body_rows(sim);
+    if sim.ranks() == 1 {
+        return rows;
+    }
+    let mut w = WireWriter::with_capacity(8 * BODY_COLUMNS.len() * rows.len());
+    for x in rows.iter().flatten() {
+        w.f64(*x);
+    }
+    let mut all = Vec::new();
+    for buf in comm.all_gather_bytes(&w.finish()) {
+        let mut r = WireReader::new(&buf);
+        while !r.is_done() {
+            let row: Vec<f64> = (0..BODY_COLUMNS.len())
+                .map(|_| r.f64().expect("body rows from another rank of this run"))
+                .collect();
+            all.push(row);
+        }
+    }
+    // Column 1 is the id (an integer below 2³², exact in an f64).
+    all.sort_by(|a, b| a[1].total_cmp(&b[1]));
+    all
+}
 
 /// Rows of `bodies.csv` at the current time, in body order: id, template index, centre of mass,
 /// orientation quaternion (principal frame → space), velocity, angular velocity.

@@ -60,6 +60,26 @@ pub struct Bodies {
     next_id: u32,
 }
 
+/// One body's whole state ([`Bodies::record`]): what travels when the body changes rank.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub(crate) struct BodyRecord {
+    pub id: u32,
+    pub template: u32,
+    pub pos: Vec3,
+    pub quat: Quat,
+    pub vel: Vec3,
+    pub omega: Vec3,
+    pub angmom: Vec3,
+    pub inv_mass: f64,
+    pub inv_inertia: Vec3,
+    pub k2: f64,
+    pub first_id: u32,
+    pub offset: Vec<Vec3>,
+    pub arm: Vec<Vec3>,
+    pub force: Vec3,
+    pub torque: Vec3,
+}
+
 /// A new body to add: where and how it moves (the shape and mass come from a template).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewBody {
@@ -167,6 +187,74 @@ impl Bodies {
         self.member_start.push(self.offset.len() as u32);
         self.force.push(Vec3::ZERO);
         self.torque.push(Vec3::ZERO);
+        self.len() - 1
+    }
+
+    /// Counts a body that another rank adds (a run split over ranks gives every body the id it has on one
+    /// rank); returns that id.
+    pub(crate) fn skip_id(&mut self) -> u32 {
+        self.next_id += 1;
+        self.next_id - 1
+    }
+
+    /// Makes the next new body's id at least `next_id` (a joined state continues the numbering of its
+    /// parts).
+    pub(crate) fn skip_to(&mut self, next_id: u32) {
+        self.next_id = self.next_id.max(next_id);
+    }
+
+    /// Largest distance of a member centre from its body's centre of mass \[m\] (0 without bodies): how
+    /// far a member may stand outside the box of the rank that owns its body.
+    pub fn largest_arm(&self) -> f64 {
+        self.offset.iter().map(|o| o.length()).fold(0.0, f64::max)
+    }
+
+    /// The whole state of body `b`, to move it to another rank or into a joined state.
+    pub(crate) fn record(&self, b: usize) -> BodyRecord {
+        let r = self.members(b);
+        BodyRecord {
+            id: self.id[b],
+            template: self.template[b],
+            pos: self.pos[b],
+            quat: self.quat[b],
+            vel: self.vel[b],
+            omega: self.omega[b],
+            angmom: self.angmom[b],
+            inv_mass: self.inv_mass[b],
+            inv_inertia: self.inv_inertia[b],
+            k2: self.k2[b],
+            first_id: self.first_id[b],
+            offset: self.offset[r.clone()].to_vec(),
+            arm: self.arm[r].to_vec(),
+            force: self.force[b],
+            torque: self.torque[b],
+        }
+    }
+
+    /// Appends the body `r` exactly as it was recorded (its members' particle indices unknown until
+    /// [`crate::Simulation`] refreshes them); returns its index. The next new body's id stays above it.
+    pub(crate) fn push_record(&mut self, r: BodyRecord) -> usize {
+        if self.member_start.is_empty() {
+            self.member_start.push(0);
+        }
+        self.next_id = self.next_id.max(r.id + 1);
+        self.id.push(r.id);
+        self.template.push(r.template);
+        self.pos.push(r.pos);
+        self.quat.push(r.quat);
+        self.vel.push(r.vel);
+        self.omega.push(r.omega);
+        self.angmom.push(r.angmom);
+        self.inv_mass.push(r.inv_mass);
+        self.inv_inertia.push(r.inv_inertia);
+        self.k2.push(r.k2);
+        self.first_id.push(r.first_id);
+        self.member_index.extend(std::iter::repeat_n(u32::MAX, r.offset.len()));
+        self.offset.extend(r.offset);
+        self.arm.extend(r.arm);
+        self.member_start.push(self.offset.len() as u32);
+        self.force.push(r.force);
+        self.torque.push(r.torque);
         self.len() - 1
     }
 

@@ -18,6 +18,7 @@ pub mod rotation;
 pub mod shapes;
 pub mod template;
 
+pub(crate) use bodies::BodyRecord;
 pub use bodies::{Bodies, NewBody, NO_BODY};
 pub use mass::MassProperties;
 pub use template::{ClumpTemplate, MassBasis};

@@ -28,12 +28,14 @@
 //!   forces of a particle in another order, so it agrees with a one-rank run to round-off, which a dense
 //!   granular packing amplifies (bulk quantities agree; trajectories of single grains do not).
 //!
-//! Clumps, the multi-step and implicit integrators and particle insertion during a run are refused on
-//! several ranks with a sentence naming what to change.
+//! Rigid bodies (clumps) live whole on the rank of their centre of mass ([`super::rank_bodies`]). The
+//! multi-step and implicit integrators are refused on several ranks with a sentence naming what to
+//! change.
 
 use super::forces::{Acc, SlotOut};
 use super::neighbors::{pair_key, Carries, PairCarry, WallCarry};
 use super::{Integrator, ParticleView, Simulation};
+use crate::clump::NO_BODY;
 use crate::contact::{ContactInput, ContactLaw, PairTable};
 use crate::error::DemError;
 use rayon::prelude::*;
@@ -168,6 +170,7 @@ impl<L: ContactLaw> Simulation<L> {
                     self.evaluate_with(comm)?;
                 }
                 let vmax = self.kick_drift(0.5, true, true);
+                let vmax = vmax.max(self.bodies_kick(0.5, true, true));
                 self.ghosts_moved();
                 if !self.settings.rotation {
                     self.clear_spins();
@@ -178,10 +181,12 @@ impl<L: ContactLaw> Simulation<L> {
                 self.half_step_velocities = false;
                 self.evaluate_with(comm)?;
                 self.kick_drift(0.5, false, false);
+                self.bodies_kick(0.5, false, false);
             }
             Integrator::SymplecticEuler => {
                 self.evaluate_with(comm)?;
                 let vmax = self.kick_drift(1.0, true, false);
+                let vmax = vmax.max(self.bodies_kick(1.0, true, false));
                 self.ghosts_moved();
                 self.advance_time_with(comm, vmax);
                 self.maybe_rebuild_with(comm);
@@ -202,16 +207,16 @@ impl<L: ContactLaw> Simulation<L> {
         DemError::Config {
             key: "ranks".into(),
             message: format!(
-                "{what} runs on one rank only in this version; use velocity_verlet or symplectic_euler with \
-                 single spheres under mpirun, or start the run without mpirun"
+                "{what} runs on one rank only in this version; use velocity_verlet or symplectic_euler under \
+                 mpirun, or start the run without mpirun"
             ),
         }
     }
 
     /// Splits the particles (every rank holds the same set) over the ranks of `comm`: each rank keeps
-    /// those in its box. Does nothing on one rank or when already split. Refuses, on every rank alike,
-    /// what runs on one rank only (clumps, multi-step and implicit integrators) and more ranks than
-    /// particles. Rank 0 keeps the energy accounts, the removal count and the mesh impact records of the
+    /// those in its box, and the bodies whose centre of mass is in its box with their members. Does
+    /// nothing on one rank or when already split. Refuses, on every rank alike, what runs on one rank
+    /// only (multi-step and implicit integrators) and more ranks than particles. Rank 0 keeps the energy accounts, the removal count and the mesh impact records of the
     /// state it splits (the set-up, or a checkpoint joined by [`Self::join_parts`]); the others start
     /// theirs from zero, so that the sums over ranks are the run's.
     pub fn decompose(&mut self, comm: &dyn Comm) -> Result<(), DemError> {
@@ -226,9 +231,6 @@ impl<L: ContactLaw> Simulation<L> {
         if comm.size() == 1 || self.decomp.is_some() {
             return Ok(());
         }
-        if !self.st.bodies.is_empty() || !self.templates.is_empty() {
-            return Err(self.refuse("a scene with clumps".into()));
-        }
         if !matches!(self.settings.integrator, Integrator::VelocityVerlet | Integrator::SymplecticEuler) {
             return Err(self.refuse(format!("the integrator {:?}", self.settings.integrator)));
         }
@@ -241,8 +243,10 @@ impl<L: ContactLaw> Simulation<L> {
             })?;
         let rank = comm.rank();
         let pending = self.collect_carries();
-        let owned: Vec<bool> = self.particles.pos.iter().map(|&x| rcb.owner(x) == rank).collect();
+        let owned: Vec<bool> = self.owner_ranks(&rcb).into_iter().map(|o| o == rank).collect();
         self.particles.retain(|i| owned[i]);
+        self.keep_owned_bodies(&rcb, rank);
+        self.refresh_members();
         self.st.list = Default::default();
         self.st.wall_list = Default::default();
         self.st.needs_rebuild = true;
@@ -325,9 +329,11 @@ impl<L: ContactLaw> Simulation<L> {
         });
         let r_max = self.st.r_max;
         let (range_pp, _) = self.range_max(r_max);
-        let width = 2.0 * r_max + range_pp + self.skin();
+        let mut arm = [self.st.bodies.largest_arm()];
+        comm.all_max_f64(&mut arm);
+        let (width, peer_width) = self.halo_widths(r_max, arm[0]);
         if let Some(d) = self.decomp.as_mut() {
-            let mut peer_ranks: Vec<usize> = d.rcb.peers(d.rank, width).iter().map(|p| p.rank).collect();
+            let mut peer_ranks: Vec<usize> = d.rcb.peers(d.rank, peer_width).iter().map(|p| p.rank).collect();
             peer_ranks.dedup();
             d.peer_ranks = peer_ranks;
         }
@@ -395,6 +401,11 @@ impl<L: ContactLaw> Simulation<L> {
         self.decomp.as_ref().map(|d| &d.rcb)
     }
 
+    /// The owner of a point and this rank's number, when the particles are split.
+    pub(super) fn decomp_owner(&self, x: Vec3) -> Option<(usize, usize)> {
+        self.decomp.as_ref().map(|d| (d.rcb.owner(x), d.rank))
+    }
+
     /// This rank's box, when the particles are split.
     pub fn rank_box(&self) -> Option<Aabb> {
         self.decomp.as_ref().map(|d| d.boxes[d.rank])
@@ -455,13 +466,13 @@ impl<L: ContactLaw> Simulation<L> {
         }
         self.remove_outside_domain();
         self.rebalance_if_needed(comm);
-        let mut r = [self.particles.radius.iter().copied().fold(0.0, f64::max)];
+        let mut r = [self.particles.radius.iter().copied().fold(0.0, f64::max), self.st.bodies.largest_arm()];
         comm.all_max_f64(&mut r);
         let r_max = r[0];
         self.st.r_max = r_max;
         let (range_pp, _) = self.range_max(r_max);
-        let width = 2.0 * r_max + range_pp + self.skin();
-        self.migrate(comm, width, &mut carry, &mut wall_carry);
+        let (width, peer_width) = self.halo_widths(r_max, r[1]);
+        self.migrate(comm, peer_width, &mut carry, &mut wall_carry);
         carry.sort_unstable_by_key(|c| c.0);
         carry.dedup_by_key(|c| c.0);
         wall_carry.sort_unstable_by_key(|c| c.0);
@@ -499,29 +510,33 @@ impl<L: ContactLaw> Simulation<L> {
         }
     }
 
-    /// Sends every particle outside this rank's box to its owner, with its wall carries and the pair
-    /// carries that involve it, and appends what arrives. Also sets the neighbours for `width`.
+    /// Sends every particle outside this rank's box to its owner (a member: every body whose centre left
+    /// it, with its members), with its wall carries and the pair carries that involve it, and appends
+    /// what arrives. Also sets the neighbours: the ranks whose boxes lie within `peer_width`.
     fn migrate(
         &mut self,
         comm: &dyn Comm,
-        width: f64,
+        peer_width: f64,
         carry: &mut Vec<PairCarry<L::State>>,
         wall_carry: &mut Vec<WallCarry<L::State>>,
     ) {
+        let Some(d) = self.decomp.as_ref() else { return };
+        let owners = self.owner_ranks(&d.rcb);
+        let leaving_bodies = self.leaving_bodies(&d.rcb, d.rank);
+        let body_ids: Vec<u32> = if self.st.bodies.is_empty() {
+            Vec::new()
+        } else {
+            (0..self.particles.len()).map(|i| self.body_id_of(i)).collect()
+        };
+        let body_records: Vec<_> =
+            leaving_bodies.iter().map(|&(o, k)| (o, self.st.bodies.record(k))).collect();
         let Some(d) = self.decomp.as_mut() else { return };
-        let mut peer_ranks: Vec<usize> = d.rcb.peers(d.rank, width).iter().map(|p| p.rank).collect();
+        let mut peer_ranks: Vec<usize> = d.rcb.peers(d.rank, peer_width).iter().map(|p| p.rank).collect();
         peer_ranks.dedup();
         d.peer_ranks = peer_ranks;
         let p = &mut self.particles;
-        let leaving: Vec<(usize, usize)> = p
-            .pos
-            .iter()
-            .enumerate()
-            .filter_map(|(i, &x)| {
-                let o = d.rcb.owner(x);
-                (o != d.rank).then_some((o, i))
-            })
-            .collect();
+        let leaving: Vec<(usize, usize)> =
+            owners.iter().enumerate().filter_map(|(i, &o)| (o != d.rank).then_some((o, i))).collect();
         let far = leaving.iter().any(|(o, _)| d.peer_ranks.binary_search(o).is_err());
         let mut flag = [u64::from(far)];
         comm.all_sum_u64(&mut flag);
@@ -539,7 +554,7 @@ impl<L: ContactLaw> Simulation<L> {
             let k = dest.binary_search(&o).expect("the owner is a destination");
             let (w, n) = &mut parts[k];
             *n += 1;
-            w.u32(p.id[i]).u32(u32::from(p.material[i]));
+            w.u32(p.id[i]).u32(u32::from(p.material[i])).u32(body_ids.get(i).copied().unwrap_or(NO_BODY));
             w.vec3(p.pos[i]).vec3(p.vel[i]).vec3(p.omega[i]).vec3(p.force[i]).vec3(p.torque[i]);
             w.f64(p.radius[i]).f64(p.inv_mass[i]);
             let (ef, et) = if has_ext { (p.ext_force[i], p.ext_torque[i]) } else { (Vec3::ZERO, Vec3::ZERO) };
@@ -565,10 +580,15 @@ impl<L: ContactLaw> Simulation<L> {
                 pairs[k].push(c);
             }
         }
+        let mut bodies: Vec<Vec<&crate::clump::BodyRecord>> = vec![Vec::new(); dest.len()];
+        for (o, r) in &body_records {
+            bodies[dest.binary_search(o).expect("the owner is a destination")].push(r);
+        }
         let out: Vec<Vec<u8>> = parts
             .into_iter()
             .zip(walls.iter().zip(&pairs))
-            .map(|((body, n), (wc, pc))| {
+            .zip(&bodies)
+            .map(|(((body, n), (wc, pc)), bc)| {
                 let mut w = WireWriter::with_capacity(0);
                 w.u32(n).bytes(&body.finish());
                 w.u32(wc.len() as u32);
@@ -580,6 +600,10 @@ impl<L: ContactLaw> Simulation<L> {
                 for c in pc {
                     w.u64(c.0);
                     put(&mut w, &c.1);
+                }
+                w.u32(bc.len() as u32);
+                for r in bc {
+                    put(&mut w, *r);
                 }
                 w.finish()
             })
@@ -595,6 +619,8 @@ impl<L: ContactLaw> Simulation<L> {
         }
         let bad = "migration message from another rank of this run";
         let mut arrived = 0;
+        let first = p.len();
+        let (mut arrived_bodies, mut arrived_body_ids) = (Vec::new(), Vec::new());
         for buf in &got {
             let mut r = WireReader::new(buf);
             let n = r.u32().expect(bad);
@@ -602,6 +628,7 @@ impl<L: ContactLaw> Simulation<L> {
             for _ in 0..n {
                 p.id.push(b.u32().expect(bad));
                 p.material.push(b.u32().expect(bad) as u16);
+                arrived_body_ids.push(b.u32().expect(bad));
                 p.pos.push(b.vec3().expect(bad));
                 p.vel.push(b.vec3().expect(bad));
                 p.omega.push(b.vec3().expect(bad));
@@ -628,8 +655,19 @@ impl<L: ContactLaw> Simulation<L> {
                 let key = r.u64().expect(bad);
                 carry.push((key, get(&mut r)));
             }
+            for _ in 0..r.u32().expect(bad) {
+                arrived_bodies.push(get(&mut r));
+            }
         }
         d.last_migrants = arrived;
+        if !leaving_bodies.is_empty() {
+            let mut keep = vec![true; self.st.bodies.len()];
+            for &(_, k) in &leaving_bodies {
+                keep[k] = false;
+            }
+            self.drop_bodies(&keep);
+        }
+        self.attach_arrived(first, &arrived_body_ids, arrived_bodies);
     }
 
     /// Sends every neighbour the owned particles within `width` of its box (kept as send lists) and
@@ -787,6 +825,9 @@ impl<L: ContactLaw> Simulation<L> {
         self.refresh_ghosts(comm);
         self.compute_forces();
         self.evaluations += 1;
+        if !self.st.bodies.is_empty() {
+            self.reduce_body_forces();
+        }
         self.st.forces_valid = true;
         let local = self.st.last.max_overlap_ratio;
         let mut m = [local];

@@ -22,6 +22,7 @@ mod forces;
 mod impacts;
 mod integrate;
 mod neighbors;
+mod rank_bodies;
 mod repartition;
 mod schemes;
 

@@ -9,12 +9,15 @@
 //! rank then goes on from there; a run on several ranks splits this state afresh with
 //! [`Simulation::decompose_over`], exactly as a run splits its set-up at the start.
 //!
+//! Rigid bodies are gathered in id order, each with its members (a body lives whole on one rank).
+//!
 //! The continued run is the same physical state with the same contact history, but not bit for bit the
 //! uninterrupted one: the lists are rebuilt at the join (a rebuild re-sorts the particles, so forces are
 //! added in another order), and on another number of ranks a particle's forces are added in another order
 //! anyway (see [`super::decomp`]).
 
 use super::decomp::RankState;
+use super::rank_bodies::JoinedBodies;
 use super::{DynState, EnergyAccounts, LastEvaluation, SimState, Simulation};
 use crate::contact::ContactLaw;
 use crate::error::DemError;
@@ -52,13 +55,9 @@ impl<L: ContactLaw> Simulation<L> {
         let (mut carry, mut wall_carry) = (Vec::new(), Vec::new());
         let mut records: Vec<Option<MeshRecords>> = Vec::new();
         let mut total: Option<DynState<L::State>> = None;
+        let mut bodies = JoinedBodies::new();
         for (rank, (state, split)) in parts.into_iter().enumerate() {
             self.restore(state).map_err(|e| DemError::Resume(format!("the part of rank {rank}: {e}")))?;
-            if !self.st.bodies.is_empty() {
-                return Err(DemError::Resume(format!(
-                    "the part of rank {rank} holds clumps, which run on one rank only in this version"
-                )));
-            }
             let (c, w) = self.collect_carries();
             carry.extend(c);
             wall_carry.extend(w);
@@ -78,7 +77,9 @@ impl<L: ContactLaw> Simulation<L> {
                     }
                 }
             }
-            joined.append(std::mem::take(&mut self.particles));
+            let mut part = std::mem::take(&mut self.particles);
+            bodies.take(&self.st.bodies, &mut part.body);
+            joined.append(part);
             let st = std::mem::take(&mut self.st);
             match total.as_mut() {
                 None => total = Some(st),
@@ -102,6 +103,7 @@ impl<L: ContactLaw> Simulation<L> {
         let mut st = total.expect("at least one part");
         st.list = Default::default();
         st.wall_list = Default::default();
+        st.bodies = bodies.finish(&mut joined.body)?;
         self.st = st;
         joined.sort_by_id();
         self.particles = joined;

@@ -17,7 +17,7 @@ use spatter_dem::contact::{
 use spatter_dem::error::DemError;
 use spatter_dem::insertion::{InjectionRate, Injector, InjectorState, Region, WallClearance};
 use spatter_dem::output::{
-    body_rows, energy_row, particles_vtu, write_mesh, write_particles, BODY_COLUMNS, ENERGY_COLUMNS,
+    body_rows_with, energy_row, particles_vtu, write_mesh, write_particles, BODY_COLUMNS, ENERGY_COLUMNS,
 };
 use spatter_dem::restitution_models::{RestitutionModel, SpeedDependentDamping};
 use spatter_dem::sim::{Integrator, RankState, SimState, Simulation};
@@ -68,8 +68,6 @@ fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result
         return Ok(());
     }
     let one_rank = [
-        ("templates", !cfg.templates.is_empty()),
-        ("inject.clumps", cfg.inject.iter().any(|j| j.clumps.is_some())),
         ("pour", cfg.pour.is_some()),
         ("bed", cfg.bed.is_some()),
         ("probe", cfg.probe.is_some()),
@@ -164,7 +162,8 @@ pub struct MeshWallResult {
     pub impacts: Vec<u64>,
 }
 
-fn results<L: ContactLaw>(sim: &Simulation<L>, events: EventLog) -> SceneResults {
+/// The records of a completed run; `bodies` are the rows of [`body_rows_with`] (every rank's bodies).
+fn results<L: ContactLaw>(sim: &Simulation<L>, events: EventLog, bodies: &[Vec<f64>]) -> SceneResults {
     let mut mesh_walls = Vec::new();
     for w in &sim.walls {
         if let spatter_dem::walls::WallShape::Mesh(m) = &w.shape {
@@ -175,11 +174,10 @@ fn results<L: ContactLaw>(sim: &Simulation<L>, events: EventLog) -> SceneResults
             });
         }
     }
-    let b = sim.bodies();
     SceneResults {
         mesh_walls,
         events,
-        bodies: (0..b.len()).map(|k| (b.id[k], b.template[k], b.pos[k])).collect(),
+        bodies: bodies.iter().map(|r| (r[1] as u32, r[2] as u32, Vec3::new(r[3], r[4], r[5]))).collect(),
         template_members: sim.templates().iter().map(|t| t.spheres.len()).collect(),
         removed_spheres: sim.removed_count(),
     }
@@ -460,12 +458,16 @@ impl Outputs {
         let e = sim.energy_with(comm);
         let count = sim.particle_count_with(comm);
         sim.gather_mesh_records(comm);
+        let bodies = match sim.templates().is_empty() {
+            true => Vec::new(),
+            false => body_rows_with(sim, comm),
+        };
         let rel = match cfg.output.particles_vtu {
             true => Some(write_particle_output(sim, ctx, self.index)?),
             false => None,
         };
         if let Some(f) = self.files.as_mut() {
-            f.write(cfg, sim, ctx, (&e, count), rel.as_deref(), self.index)?;
+            f.write(cfg, sim, ctx, (&e, count, &bodies), rel.as_deref(), self.index)?;
         }
         self.index += 1;
         Ok(())
@@ -534,14 +536,15 @@ impl OutputFiles {
         Ok(())
     }
 
-    /// Rank 0's part of an output: the energy row (`e` and the particle `count` over all ranks), bodies,
-    /// wear, the `.pvd` entry of the particle output `rel` and the mesh walls.
+    /// Rank 0's part of an output: the energy row (`e` and the particle `count` over all ranks), the
+    /// `bodies` rows (of all ranks), wear, the `.pvd` entry of the particle output `rel` and the mesh
+    /// walls.
     fn write<L: ContactLaw>(
         &mut self,
         cfg: &SceneConfig,
         sim: &Simulation<L>,
         ctx: &RunContext,
-        (e, count): (&spatter_dem::EnergyReport, u64),
+        (e, count, bodies): (&spatter_dem::EnergyReport, u64, &[Vec<f64>]),
         rel: Option<&str>,
         index: u64,
     ) -> Result<(), DemError> {
@@ -553,8 +556,8 @@ impl OutputFiles {
         row[2] = count as f64;
         self.csv.row(&row).map_err(io(self.csv.path()))?;
         if let Some(b) = &mut self.bodies {
-            for row in body_rows(sim) {
-                b.row(&row).map_err(io(b.path()))?;
+            for row in bodies {
+                b.row(row).map_err(io(b.path()))?;
             }
         }
         if let Some(w) = &mut self.wear {
@@ -1007,6 +1010,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         energy: sim.energy_with(comm),
         particles: sim.particle_count_with(comm),
         removed: sim.removed_count_with(comm),
+        bodies: body_rows_with(&sim, comm),
     };
     sim.gather_mesh_records(comm);
     let mut s = summary(cfg, &sim, &totals, &injectors, &warnings, ctx);
@@ -1022,7 +1026,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         s.maps.push(record);
     }
     partner.finish(&sim, ctx, &mut s)?;
-    let mut r = results(&sim, events);
+    let mut r = results(&sim, events, &totals.bodies);
     r.removed_spheres = totals.removed;
     Ok((s, Some(r)))
 }
@@ -1144,7 +1148,7 @@ fn inject_with<L: ContactLaw>(
         for p in placed {
             let body = NewBody { pos: p.pos, quat: p.quat, vel: inj.velocity, omega: Vec3::ZERO };
             // The template and material were checked when the scene was built.
-            if let Err(e) = sim.add_clump(mix.shapes[p.slot].template, inj.material, body) {
+            if let Err(e) = sim.add_clump_split(mix.shapes[p.slot].template, inj.material, body) {
                 tracing::error!("inject[{k}]: {e}");
             }
         }
@@ -1265,6 +1269,8 @@ struct Totals {
     energy: spatter_dem::EnergyReport,
     particles: u64,
     removed: u64,
+    /// Rows of `bodies.csv` of every rank, in id order.
+    bodies: Vec<Vec<f64>>,
 }
 
 fn summary<L: ContactLaw>(
@@ -1298,10 +1304,10 @@ fn summary<L: ContactLaw>(
     if !sim.templates().is_empty() {
         s.headline.push(format!(
             "{} rigid bodies (clumps) of {} templates",
-            sim.bodies().len(),
+            totals.bodies.len(),
             sim.templates().len()
         ));
-        s.scalar("bodies", sim.bodies().len() as f64);
+        s.scalar("bodies", totals.bodies.len() as f64);
     }
     if !sim.wear().is_empty() {
         let mut total = 0.0;
