@@ -519,7 +519,8 @@ fn drive<L: ContactLaw>(
         }
         let events = &mut st.events;
         let (rep, frep) = c.step_observed(|dem| {
-            record_step(dem_cfg, dem, events, trajectories.as_mut()).map_err(CfdDemError::Dem)
+            record_step(dem_cfg, dem, events, trajectories.as_mut(), &spatter_core::comm::SERIAL)
+                .map_err(CfdDemError::Dem)
         })?;
         st.coupling_steps += 1;
         st.last = rep;

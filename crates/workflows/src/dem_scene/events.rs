@@ -92,7 +92,7 @@ fn check_direction(c: &mut Checker, key: &str, v: Vec3) {
 }
 
 /// A body (`true`) or a free sphere (`false`) and its stable id.
-type Key = (bool, u32);
+pub(super) type Key = (bool, u32);
 
 /// The first wall impact of a body or free sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -134,19 +134,24 @@ pub struct ObjectRecord {
     pub first: Option<FirstImpact>,
     /// Contacts formed per wall (a body touching a wall with several members in one step counts once).
     pub collisions: Vec<u64>,
-    /// Signed distance to the crossing plane after the last step (NaN before the first).
-    side: f64,
+    /// Signed distance to the crossing plane after the last step (NaN before the first, and on a rank
+    /// the object has left).
+    pub(super) side: f64,
     pub crossing: Option<Crossing>,
 }
 
 /// The state of the event log (checkpointed).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EventLog {
-    records: BTreeMap<Key, ObjectRecord>,
+    pub(super) records: BTreeMap<Key, ObjectRecord>,
+    /// List rebuilds of the simulation at the last step taken in (the only steps at which objects change
+    /// rank; `None` until the first step after a start or resume).
+    #[serde(skip)]
+    pub(super) rebuilds_seen: Option<u64>,
 }
 
 impl EventLog {
-    fn record(&mut self, key: Key, template: i64, walls: usize) -> &mut ObjectRecord {
+    pub(super) fn record(&mut self, key: Key, template: i64, walls: usize) -> &mut ObjectRecord {
         self.records.entry(key).or_insert_with(|| ObjectRecord {
             template,
             collisions: vec![0; walls],

@@ -4,6 +4,7 @@
 mod bed_outputs;
 mod clumps;
 mod config;
+mod event_ranks;
 pub mod events;
 pub mod pour;
 pub mod probe;

@@ -1,7 +1,8 @@
 //! Running a scene: law selection, time loop, injection, outputs, checkpoint and resume.
 
 use super::config::{NormalKind, SceneConfig, TangentialKind};
-use super::events::{trajectory_rows, EventLog, TRAJECTORY_COLUMNS};
+use super::event_ranks::trajectory_rows_with;
+use super::events::{EventLog, TRAJECTORY_COLUMNS};
 use super::setup;
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
@@ -71,8 +72,6 @@ fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result
         ("pour", cfg.pour.is_some()),
         ("bed", cfg.bed.is_some()),
         ("probe", cfg.probe.is_some()),
-        ("output.events", cfg.output.events.is_some()),
-        ("output.trajectories", cfg.output.trajectories.is_some()),
         (
             "engine.integrator",
             !matches!(cfg.engine.integrator, Integrator::VelocityVerlet | Integrator::SymplecticEuler),
@@ -625,20 +624,25 @@ pub(crate) fn write_mesh_snapshots<L: ContactLaw>(
 
 /// After a step: the wall impacts and plane crossings into the event log (with `[output.events]`), and
 /// the followed objects' rows into `trajectories` every `every_steps` steps (with
-/// `[output.trajectories]`; `None` on the ranks that write no files).
+/// `[output.trajectories]`; `None` on the ranks that write no files). Collective on several ranks.
 pub(crate) fn record_step<L: ContactLaw>(
     cfg: &SceneConfig,
     sim: &Simulation<L>,
     events: &mut EventLog,
     trajectories: Option<&mut CsvSeries>,
+    comm: &dyn Comm,
 ) -> Result<(), DemError> {
     if let Some(e) = &cfg.output.events {
+        events.hand_over(sim, comm);
         events.after_step(sim, e);
     }
-    if let (Some(tc), Some(tr)) = (&cfg.output.trajectories, trajectories) {
+    if let Some(tc) = &cfg.output.trajectories {
         if sim.step_count() % tc.every_steps == 0 {
-            for row in trajectory_rows(sim, tc) {
-                tr.row(&row).map_err(|source| DemError::Io { path: tr.path().to_owned(), source })?;
+            let rows = trajectory_rows_with(sim, tc, comm);
+            if let Some(tr) = trajectories {
+                for row in rows {
+                    tr.row(&row).map_err(|source| DemError::Io { path: tr.path().to_owned(), source })?;
+                }
             }
         }
     }
@@ -748,7 +752,9 @@ fn resume_sim<L: ContactLaw, P: StepPartner>(
     ctx: &RunContext,
 ) -> Result<Checkpoint<L::State, P::State>, DemError> {
     let comm = ctx.comm;
-    let (ck, parts) = match ctx.load_checkpoint_parts::<Checkpoint<L::State, P::State>, RankPart<_, _>>()? {
+    let (mut ck, parts) = match ctx
+        .load_checkpoint_parts::<Checkpoint<L::State, P::State>, RankPart<_, _>>()?
+    {
         Resumed::Mine(RankPart { mut scene, rank }) => {
             sim.restore(std::mem::take(&mut scene.sim)).map_err(DemError::Resume)?;
             match rank {
@@ -770,13 +776,21 @@ fn resume_sim<L: ContactLaw, P: StepPartner>(
                 return Err(DemError::Resume("the checkpoint has no parts".into()));
             };
             let mut states = vec![(std::mem::take(&mut ck.sim), rank)];
-            states.extend(parts.map(|p| (p.scene.sim, p.rank)));
+            for p in parts {
+                ck.events.merge(p.scene.events);
+                states.push((p.scene.sim, p.rank));
+            }
             (ck, states)
         }
     };
     sim.join_parts(parts)?;
     if comm.size() > 1 {
         sim.decompose_over(comm, &split_points(cfg, sim))?;
+        // Rank 0 keeps the joined event log (the first step hands each object's plane side on to its
+        // new owner); the others start empty, so that the merged log counts every record once.
+        if !comm.is_root() {
+            ck.events = EventLog::default();
+        }
     }
     Ok(ck)
 }
@@ -940,7 +954,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             } else {
                 ctx.save_checkpoint(&ck).map_err(DemError::from)?;
             }
-            write_events(cfg, &sim, &events, ctx)?;
+            write_events(cfg, &sim, &events.gathered(comm), ctx)?;
         }
         if stop {
             let mut s = RunSummary::new(Finished::Interrupted);
@@ -975,7 +989,8 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         if let (Some(p), Some(st)) = (&cfg.probe, probe.as_mut()) {
             super::probe::after_step(p, &sim, st, probe_every);
         }
-        record_step(cfg, &sim, &mut events, out.files.as_mut().and_then(|f| f.trajectories.as_mut()))?;
+        let trajectories = out.files.as_mut().and_then(|f| f.trajectories.as_mut());
+        record_step(cfg, &sim, &mut events, trajectories, comm)?;
         if sim.step_count() % out_every == 0 || sim.step_count() == total_steps || probe_ends {
             out.write(cfg, &mut sim, ctx)?;
             partner.output(&sim, ctx)?;
@@ -999,6 +1014,8 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         }
     }
     out.flush()?;
+    // The log of the whole run (every rank's records merged) for the file, the summary and the results.
+    let events = events.gathered(comm);
     write_events(cfg, &sim, &events, ctx)?;
     // The checkpoint is of no more use: `checkpoint.bin` and, when ranks wrote it (also a checkpoint of
     // several ranks continued on one), its parts.
@@ -1031,15 +1048,15 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     Ok((s, Some(r)))
 }
 
-/// Writes `events.csv` (the whole log so far; rewritten at every checkpoint and at the end) when the
-/// scene keeps an event log.
+/// Writes `events.csv` (the whole log so far, on several ranks gathered by [`EventLog::gathered`];
+/// rewritten at every checkpoint and at the end) when the scene keeps an event log; rank 0 only.
 pub(crate) fn write_events<L: ContactLaw>(
     cfg: &SceneConfig,
     sim: &Simulation<L>,
     log: &EventLog,
     ctx: &RunContext,
 ) -> Result<(), DemError> {
-    if cfg.output.events.is_none() {
+    if cfg.output.events.is_none() || !ctx.comm.is_root() {
         return Ok(());
     }
     let path = ctx.dir.path("events.csv");
