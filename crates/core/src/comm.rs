@@ -53,6 +53,12 @@ pub trait Comm: Send + Sync {
     /// write of its own piece, a panic): never leaves the other ranks waiting.
     fn abort(&self, code: i32) -> !;
 
+    /// Whether the collectives may be called from any thread (one at a time), not only from the thread
+    /// that started the transport: then a run may drive its steps from a worker of its thread pool.
+    fn calls_from_any_thread(&self) -> bool {
+        true
+    }
+
     /// Element-wise sum over all ranks, added in rank order on every rank, so every rank holds the same
     /// bits whatever the transport does (an MPI sum may group terms differently on different ranks).
     fn sum_f64_ordered(&self, values: &mut [f64]) {

@@ -18,18 +18,23 @@ const TAG_DATA: i32 = 0x5A12;
 pub struct MpiComm {
     rank: usize,
     size: usize,
+    /// MPI granted calls from any thread, one at a time (`MPI_THREAD_SERIALIZED` or more).
+    any_thread: bool,
 }
 
 pub(crate) fn init(launcher_rank: usize) -> Result<Launch, LaunchError> {
-    // Funneled: rayon's worker threads compute, only the thread that runs the step calls MPI.
-    let Some((universe, _level)) = mpi::initialize_with_threading(mpi::Threading::Funneled) else {
+    // Serialized: rayon's worker threads compute, and the one that runs the step (a worker, see
+    // `Comm::calls_from_any_thread`) calls MPI. An MPI that grants less keeps the steps on the main
+    // thread (funneled).
+    let Some((universe, level)) = mpi::initialize_with_threading(mpi::Threading::Serialized) else {
         return Err(LaunchError {
             rank: launcher_rank,
             message: "MPI was already initialised in this process".into(),
         });
     };
     let world = universe.world();
-    let comm = MpiComm { rank: world.rank() as usize, size: world.size() as usize };
+    let any_thread = level >= mpi::Threading::Serialized;
+    let comm = MpiComm { rank: world.rank() as usize, size: world.size() as usize, any_thread };
     // A panic on one rank must end the whole job, never leave the other ranks waiting in a collective.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -75,6 +80,9 @@ impl Comm for MpiComm {
     }
     fn size(&self) -> usize {
         self.size
+    }
+    fn calls_from_any_thread(&self) -> bool {
+        self.any_thread
     }
     fn all_max_f64(&self, values: &mut [f64]) {
         // MPI_MAX on doubles: exact in any order. A NaN is turned into +∞ first so that it wins on every

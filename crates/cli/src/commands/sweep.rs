@@ -100,7 +100,9 @@ pub fn sweep(
     );
     let opts = SweepOptions { out: out.clone(), shard, overwrite };
     let runner = InProcess { control: &control };
-    let result = spatter_study::run_study(&study, &plan, &opts, &runner, &control);
+    let result = super::run::on_worker(&spatter_core::comm::SERIAL, || {
+        spatter_study::run_study(&study, &plan, &opts, &runner, &control)
+    });
     control.finish();
     let outcome = result?;
     println!(
