@@ -114,22 +114,6 @@ fn hopper_on_two_ranks_matches_one() {
     assert_eq!(w1.len(), w2.len());
 }
 
-/// The largest difference between the columns of two CSV series of the same shape, each over the scale
-/// of its column in `a` (its largest magnitude); the series must have the same columns and rows.
-fn largest_relative_difference(a: &Path, b: &Path) -> f64 {
-    let ((ca, ra), (cb, rb)) = (csv(a), csv(b));
-    assert_eq!(ca, cb, "{}", a.display());
-    assert_eq!(ra.len(), rb.len(), "rows of {}", a.display());
-    let mut worst: f64 = 0.0;
-    for c in 0..ca.len() {
-        let scale = ra.iter().map(|r| r[c].abs()).fold(0.0, f64::max).max(1e-300);
-        for (x, y) in ra.iter().zip(&rb) {
-            worst = worst.max((x[c] - y[c]).abs() / scale);
-        }
-    }
-    worst
-}
-
 /// The stones example (`examples/dem_stones.toml`: clumps of two templates injected above a mesh panel,
 /// Finnie wear) for 0.06 s (40 000 steps; a stone every 5 ms, the first reach the panel after about
 /// 0.045 s) on 2 ranks against 1. The split cuts through the injection region, so stones are placed on both ranks and
@@ -150,9 +134,8 @@ fn stones_on_two_ranks_match_one() {
     assert!(bodies.last().unwrap()[1] >= 10.0, "stones were injected");
     assert!(wear.last().unwrap()[1] > 0.0, "stones hit the panel");
     for file in ["bodies.csv", "energy.csv", "wear.csv"] {
-        let d = largest_relative_difference(&one.join(file), &two.join(file));
+        let d = assert_same_table(&one.join(file), &two.join(file));
         eprintln!("stones on 2 ranks: {file} within {d:e} of one rank");
-        assert!(d <= 1e-9, "{file}: {d:e}");
     }
     // The run summary's body count (rank 0's summary on 2 ranks) counts the bodies of both ranks.
     let bodies_counted = |dir: &Path, n: usize| {
@@ -370,9 +353,8 @@ fn stones_resume_on_two_ranks_bit_for_bit_and_on_one() {
     assert_eq!(done, [Ok(Finished::Completed)]);
     let (_, rows) = csv(&full.join("bodies.csv"));
     assert!(rows.len() >= 8, "stones in flight: {} rows", rows.len());
-    let d = largest_relative_difference(&full.join("bodies.csv"), &dir("on_one").join("bodies.csv"));
+    let d = assert_same_table(&full.join("bodies.csv"), &dir("on_one").join("bodies.csv"));
     eprintln!("stones from 2 ranks resumed on 1: bodies.csv within {d:e}");
-    assert!(d <= 1e-9, "bodies.csv: {d:e}");
 }
 
 /// Spheres and pebbles (clumps) thrown across a 10 cm box of planes under gravity, with the event log

@@ -7,10 +7,9 @@ use spatter_core::comm::{Comm, ThreadComm, WireReader, WireWriter};
 use spatter_core::material::Material;
 use spatter_core::motion::Motion;
 use spatter_core::Vec3;
-use spatter_dem::contact::{ContactLaw, HertzMindlinRolling, PairTable};
-use spatter_dem::sim::uniform_pairs;
+use spatter_dem::contact::{ContactLaw, HertzMindlinRolling};
 use spatter_dem::walls::{Plane, Wall, WallShape};
-use spatter_dem::{Settings, Simulation};
+use spatter_dem::Simulation;
 use std::sync::mpsc;
 use std::time::Duration;
 
@@ -72,23 +71,10 @@ pub fn all_ids<L: spatter_dem::contact::ContactLaw>(sim: &Simulation<L>, comm: &
     ids
 }
 
-/// The empty 10 cm box of a pile (frictional floor, frictionless sides, rolling resistance; gravity,
-/// Δt = 40 µs): the materials, pairs and box of the engine's settled-pile validation case.
+/// The empty 10 cm box of a pile: the engine's settled-pile validation box
+/// ([`spatter_dem::validation::bulk::settled_pile_box`]).
 pub fn pile_box() -> Simulation<HertzMindlinRolling> {
-    let mats = vec![soft(), soft()];
-    let base = uniform_pairs(&mats, 0.5, 0.3);
-    let pairs = PairTable::build(2, |a, b| {
-        let mut p = base.get(a, b).clone();
-        p.rolling_friction = 0.05;
-        if a != b {
-            p.friction = 0.0;
-        }
-        p
-    });
-    let mut sim = Simulation::new(HertzMindlinRolling::default(), mats, pairs, 4e-5, Settings::default());
-    sim.gravity = Vec3::new(0.0, 0.0, -9.81);
-    box_planes(&mut sim, 0.1, 1, 0);
-    sim
+    spatter_dem::validation::bulk::settled_pile_box()
 }
 
 /// Id, position and velocity of every particle on every rank, sorted by id (collective).
