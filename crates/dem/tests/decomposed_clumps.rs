@@ -179,7 +179,7 @@ fn run_clumps(ranks: usize, early: u64, steps: u64) -> ClumpEnd {
 ///   10⁻⁶ of the released potential energy; measured 1.4·10⁻¹⁰, and 3·10⁻²⁵ below the floor force),
 ///   with the centre of mass within 0.1 % of the pile height (measured 2·10⁻⁷) and the energy residual
 ///   within 10⁻³ of the released energy of the one-rank run's (measured 8·10⁻⁷). The residual itself
-///   is 0.127 on every rank count: at this Δt a 3 mm sphere's impact lasts only a few steps and the
+///   is 0.127 on every rank count: at this Δt a 3 mm sphere's impact lasts about ten steps and the
 ///   per-contact dissipation is exact only to O(Δt) (`docs/dem.md` §2); a free sphere dropped alone in
 ///   this box shows the same 10 %.
 #[test]
