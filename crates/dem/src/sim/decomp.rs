@@ -1039,6 +1039,24 @@ impl<L: ContactLaw> Simulation<L> {
         e
     }
 
+    /// Every rank's particles in one store, in id order (collective on a split run; a copy of the
+    /// particles otherwise). Body indices of members are those of each rank's own bodies: for the
+    /// particles' geometry and motion (bed files, packing densities), not for rigid-body bookkeeping.
+    pub fn gathered_particles(&self, comm: &dyn Comm) -> crate::particles::Particles {
+        if self.decomp.is_none() {
+            return self.particles.clone();
+        }
+        let bytes = bincode::serialize(&self.particles).expect("particles serialise to memory");
+        let mut all = crate::particles::Particles::new();
+        for buf in comm.all_gather_bytes(&bytes) {
+            let part: crate::particles::Particles =
+                bincode::deserialize(&buf).expect("particles from another rank of this run");
+            all.append(part);
+        }
+        all.sort_by_id();
+        all
+    }
+
     /// Total contact force on wall `w` over all ranks \[N\].
     pub fn wall_force_with(&self, comm: &dyn Comm, w: usize) -> Vec3 {
         let f = self.wall_force(w);

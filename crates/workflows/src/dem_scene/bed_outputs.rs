@@ -22,7 +22,17 @@ pub(crate) fn finish<L: ContactLaw>(
         let p = p.to_owned();
         move |source| DemError::Io { path: p, source }
     };
-    let p = &sim.particles;
+    // On several ranks every rank's particles (collective), and only rank 0 writes the files.
+    let gathered;
+    let p = if sim.ranks() > 1 {
+        gathered = sim.gathered_particles(ctx.comm);
+        &gathered
+    } else {
+        &sim.particles
+    };
+    if !ctx.comm.is_root() {
+        return Ok(());
+    }
     if let (Some(pc), Some(state)) = (&cfg.pour, pour) {
         s.scalar("poured", state.poured as f64);
         let (ke, scale) = kinetic_and_scale(p, sim.gravity.length());

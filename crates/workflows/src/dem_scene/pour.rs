@@ -13,6 +13,7 @@
 use super::config::{RegionConfig, SceneConfig};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
+use spatter_core::comm::{Comm, WireReader, WireWriter};
 use spatter_core::distribution::SizeDistribution;
 use spatter_core::rng::{seeded, Rng, RngExt};
 use spatter_core::Vec3;
@@ -288,39 +289,53 @@ pub(crate) fn add_next<L: ContactLaw>(
     p: &PourConfig,
     material: u16,
     state: &mut PourState,
+    comm: &dyn Comm,
 ) -> Result<(), DemError> {
     let Some((fp, z0, z1)) = footprint(&p.region) else { return Ok(()) };
+    let split = sim.ranks() > 1;
     let t = sim.time();
     let g = sim.gravity.length();
     let parts = &sim.particles;
-    // Which of the falling spheres still fall freely.
+    // Which of the falling spheres still fall freely (on ranks: as the rank holding each finds).
     let tol = 4.0 * g * sim.dt;
-    let mut still = vec![false; state.falling.len()];
+    let mut still = vec![0.0; state.falling.len()];
     for i in 0..parts.len() {
         if let Some(k) = state.falling.iter().position(|f| f.0 == parts.id[i]) {
             let (_, t0, vz0) = state.falling[k];
-            still[k] = (parts.vel[i].z - (vz0 - g * (t - t0))).abs() <= tol
+            let free = (parts.vel[i].z - (vz0 - g * (t - t0))).abs() <= tol
                 && parts.vel[i].x == p.velocity_m_s.x
                 && parts.vel[i].y == p.velocity_m_s.y;
+            still[k] = f64::from(u8::from(free));
         }
+    }
+    if split {
+        comm.all_max_f64(&mut still);
     }
     let mut k = 0;
     state.falling.retain(|_| {
         k += 1;
-        still[k - 1]
+        still[k - 1] > 0.0
     });
     let d = p.size.sample(&mut state.rng);
     let r = 0.5 * d;
     let u: f64 = state.rng.random();
     let gap = r * (p.gap_radii[0] + u * (p.gap_radii[1] - p.gap_radii[0]));
-    let r_max = parts.radius.iter().copied().fold(r, f64::max);
-    let mut top = z0;
+    let mut r_max = [parts.radius.iter().copied().fold(r, f64::max)];
+    if split {
+        comm.all_max_f64(&mut r_max);
+    }
+    let r_max = r_max[0];
+    let mut top = [z0];
     for i in 0..parts.len() {
         let quiet = parts.vel[i].length_squared() <= g * parts.radius[i];
         if quiet && fp.covers(parts.pos[i], r_max) && !state.falling.iter().any(|f| f.0 == parts.id[i]) {
-            top = top.max(parts.pos[i].z + parts.radius[i]);
+            top[0] = top[0].max(parts.pos[i].z + parts.radius[i]);
         }
     }
+    if split {
+        comm.all_max_f64(&mut top);
+    }
+    let top = top[0];
     let z = top + gap + r;
     if z + r > z1 {
         return Err(DemError::Config {
@@ -334,16 +349,22 @@ pub(crate) fn add_next<L: ContactLaw>(
         });
     }
     let walls = WallClearance::new(&sim.walls, t);
-    let near: Vec<usize> =
-        (0..parts.len()).filter(|&i| (parts.pos[i].z - z).abs() < parts.radius[i] + r).collect();
+    // The spheres near the release height (of every rank; the test below does not depend on order).
+    let mut near: Vec<(Vec3, f64)> = (0..parts.len())
+        .filter(|&i| (parts.pos[i].z - z).abs() < parts.radius[i] + r)
+        .map(|i| (parts.pos[i], parts.radius[i]))
+        .collect();
+    if split {
+        near = gather_spheres(&near, comm);
+    }
     for _ in 0..TRIES {
         let (x, y) = fp.sample(r, &mut state.rng);
         let pos = Vec3::new(x, y, z);
-        let clear = near.iter().all(|&i| (parts.pos[i] - pos).length() >= parts.radius[i] + r);
+        let clear = near.iter().all(|&(xi, ri)| (xi - pos).length() >= ri + r);
         if clear && walls.overlapping(pos, r).is_none() {
             let mut np = NewParticle::at(pos, r, material);
             np.vel = p.velocity_m_s;
-            let id = sim.add_particle(np);
+            let id = sim.add_particle_split(np);
             state.falling.push((id, t, p.velocity_m_s.z));
             state.poured += 1;
             state.last_pour_s = t;
@@ -352,6 +373,23 @@ pub(crate) fn add_next<L: ContactLaw>(
     }
     state.postponed += 1;
     Ok(())
+}
+
+/// Every rank's (centre, radius) pairs (collective).
+fn gather_spheres(mine: &[(Vec3, f64)], comm: &dyn Comm) -> Vec<(Vec3, f64)> {
+    let mut w = WireWriter::with_capacity(32 * mine.len());
+    for (x, r) in mine {
+        w.vec3(*x).f64(*r);
+    }
+    let mut all = Vec::new();
+    for buf in comm.all_gather_bytes(&w.finish()) {
+        let mut rd = WireReader::new(&buf);
+        let bad = "pour message from another rank of this run";
+        while !rd.is_done() {
+            all.push((rd.vec3().expect(bad), rd.f64().expect(bad)));
+        }
+    }
+    all
 }
 
 /// Kinetic energy (translation and rotation, solid spheres) and Σ m g d of the free spheres \[J\].
@@ -372,7 +410,12 @@ pub(crate) fn kinetic_and_scale(p: &Particles, g: f64) -> (f64, f64) {
 /// Whether the pour is settled at the current time: every sphere poured, the last one given the time to
 /// fall freely through the whole region height, and the kinetic energy below `settled_energy_ratio`
 /// × Σ m g d.
-pub(crate) fn settled<L: ContactLaw>(sim: &Simulation<L>, p: &PourConfig, state: &PourState) -> bool {
+pub(crate) fn settled<L: ContactLaw>(
+    sim: &Simulation<L>,
+    p: &PourConfig,
+    state: &PourState,
+    comm: &dyn Comm,
+) -> bool {
     if state.poured < p.count {
         return false;
     }
@@ -383,7 +426,11 @@ pub(crate) fn settled<L: ContactLaw>(sim: &Simulation<L>, p: &PourConfig, state:
         return false;
     }
     let (ke, scale) = kinetic_and_scale(&sim.particles, g);
-    ke <= p.settled_energy_ratio * scale
+    let mut sums = [ke, scale];
+    if sim.ranks() > 1 {
+        comm.sum_f64_ordered(&mut sums);
+    }
+    sums[0] <= p.settled_energy_ratio * sums[1]
 }
 
 /// The packing profile box of a pour region: the box itself, or for a cylinder the square inscribed in

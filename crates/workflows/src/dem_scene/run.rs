@@ -69,7 +69,6 @@ fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result
         return Ok(());
     }
     let one_rank = [
-        ("pour", cfg.pour.is_some()),
         ("bed", cfg.bed.is_some()),
         ("probe", cfg.probe.is_some()),
         (
@@ -93,8 +92,9 @@ fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result
 
 /// `b` grown by the injection regions and the mesh walls: the box particles can reach.
 fn reach_bounds<L: ContactLaw>(mut b: Aabb, cfg: &SceneConfig, sim: &Simulation<L>) -> Aabb {
-    for j in &cfg.inject {
-        if let Ok(r) = setup::region(&j.region) {
+    let regions = cfg.inject.iter().map(|j| &j.region).chain(cfg.pour.iter().map(|p| &p.region));
+    for region in regions {
+        if let Ok(r) = setup::region(region) {
             b = b.union(r.bounds());
         }
     }
@@ -107,11 +107,11 @@ fn reach_bounds<L: ContactLaw>(mut b: Aabb, cfg: &SceneConfig, sim: &Simulation<
 }
 
 /// The points the split over ranks balances: the particles at the start, and for a scene with
-/// injection also a 16 × 16 × 16 lattice over where particles will be (the engine's domain when given,
-/// else the box around the injection regions, the mesh walls and the particles).
+/// injection or a pour also a 16 × 16 × 16 lattice over where particles will be (the engine's domain
+/// when given, else the box around the injection and pour regions, the mesh walls and the particles).
 fn split_points<L: ContactLaw>(cfg: &SceneConfig, sim: &Simulation<L>) -> Vec<Vec3> {
     let mut points = sim.particles.pos.clone();
-    if cfg.inject.is_empty() {
+    if cfg.inject.is_empty() && cfg.pour.is_none() {
         return points;
     }
     let b = match (cfg.engine.domain_min_m, cfg.engine.domain_max_m) {
@@ -973,7 +973,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         }
         if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
             if step % pour_every == 0 && state.poured < p.count {
-                super::pour::add_next(&mut sim, p, pour_material, state)?;
+                super::pour::add_next(&mut sim, p, pour_material, state, comm)?;
             }
         }
         // The step that takes the probe to its largest depth ends the run with an output.
@@ -996,7 +996,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             partner.output(&sim, ctx)?;
             // A pour is checked for rest at the outputs, so that a run ending early ends on one.
             if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
-                if state.settled_s.is_none() && super::pour::settled(&sim, p, state) {
+                if state.settled_s.is_none() && super::pour::settled(&sim, p, state, comm) {
                     state.settled_s = Some(sim.time());
                     tracing::info!("pour settled at t = {:.6} s", sim.time());
                     if p.stop_when_settled {
