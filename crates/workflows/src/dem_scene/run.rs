@@ -998,7 +998,9 @@ fn run_with<L: ContactLaw, P: StepPartner>(
             if let (Some(p), Some(state)) = (&cfg.pour, pour.as_mut()) {
                 if state.settled_s.is_none() && super::pour::settled(&sim, p, state, comm) {
                     state.settled_s = Some(sim.time());
-                    tracing::info!("pour settled at t = {:.6} s", sim.time());
+                    if root {
+                        tracing::info!("pour settled at t = {:.6} s", sim.time());
+                    }
                     if p.stop_when_settled {
                         break;
                     }
