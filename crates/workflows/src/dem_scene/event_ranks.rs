@@ -104,10 +104,10 @@ fn local_objects<L: ContactLaw>(sim: &Simulation<L>) -> BTreeSet<Key> {
 
 /// The template of a local body (−1 for a sphere).
 fn template_of<L: ContactLaw>(sim: &Simulation<L>, key: Key) -> i64 {
-    let b = sim.bodies();
-    match key.0 {
-        true => b.id.iter().position(|&id| id == key.1).map_or(-1, |k| b.template[k] as i64),
-        false => -1,
+    if key.0 {
+        super::events::body_template(sim.bodies(), key.1)
+    } else {
+        -1
     }
 }
 

@@ -165,10 +165,7 @@ impl EventLog {
         let t = sim.time();
         let walls = sim.walls.len();
         let bodies = sim.bodies();
-        let template_of = |b: u32| -> i64 {
-            // Body ids grow in insertion order and removal keeps the order: the ids are sorted.
-            bodies.id.binary_search(&b).map_or(-1, |k| bodies.template[k] as i64)
-        };
+        let template_of = |b: u32| body_template(bodies, b);
         let plane = cfg.angle_plane_normal.map(|m| m.normalize());
         let counts_as_first = |w: usize| {
             cfg.first_impact_walls.is_empty()
@@ -307,6 +304,14 @@ impl EventLog {
         let crossed = self.records.values().filter(|r| r.crossing.is_some()).count();
         (hit, crossed)
     }
+}
+
+/// The template of the body with id `b` among `bodies` (−1 when it is not there). On one rank the ids are
+/// sorted (they grow in insertion order and removal keeps the order); on several ranks bodies that
+/// arrived from another rank are appended, so a miss of the binary search looks through them.
+pub(super) fn body_template(bodies: &spatter_dem::clump::Bodies, b: u32) -> i64 {
+    let k = bodies.id.binary_search(&b).ok().or_else(|| bodies.id.iter().position(|&x| x == b));
+    k.map_or(-1, |k| bodies.template[k] as i64)
 }
 
 fn first_impact(imp: &WallImpact, plane: Option<Vec3>) -> FirstImpact {
