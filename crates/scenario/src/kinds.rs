@@ -95,7 +95,7 @@ kinds! {
         "Flow on a Cartesian grid coupled two-way to a DEM scene (volume-averaged CFD-DEM): fluidised and fixed beds, settling.";
     "forces" => Forces(spatter_workflows::deposition::ForcesConfig, spatter_workflows::deposition::forces::run), ranks = false,
         "Nondimensional ranking of the particle-fluid forces for given scales (Jasion 2013 Table 6.4).";
-    "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run), ranks = false,
+    "gravelometer" => Gravelometer(spatter_workflows::gravelometer::GravelometerConfig, spatter_workflows::gravelometer::run), ranks = true,
         "Stone-chip test (DIN 55996-1, SAE J400): stones shot through a pipe at a coated panel; damage map, strip shares, impact statistics.";
     "brownout" => Brownout(spatter_workflows::brownout::BrownoutConfig, spatter_workflows::brownout::run), ranks = false,
         "Rotor over a sand bed: lift-off map, entrainment source, dust cloud concentration and optical depth.";

@@ -272,6 +272,15 @@ pub struct ParticleView<'a> {
 /// reproducible runs.
 pub trait ExternalForces: Send + Sync {
     fn add(&mut self, time: f64, particles: &ParticleView, force: &mut [Vec3], torque: &mut [Vec3]);
+
+    /// True when the force and torque on each particle depend only on the time and that particle's own
+    /// state (a drag from a prescribed or imported flow), so that on several ranks each rank may call the
+    /// hook for the particles it owns and get what one rank would. A hook that looks at other particles
+    /// (a void fraction, a bed's surface) keeps the default `false`, and runs that use it are refused on
+    /// several ranks.
+    fn per_particle(&self) -> bool {
+        false
+    }
 }
 
 #[derive(Default)]

@@ -14,6 +14,7 @@ use super::config::SceneConfig;
 use crate::bed_lab::probe_analysis::{analyse, ProbeAnalysis, GAMMA_MAX_LENGTH_DP};
 use serde::{Deserialize, Serialize};
 use spatter_core::check::Checker;
+use spatter_core::comm::Comm;
 use spatter_core::mesh::TriMesh;
 use spatter_core::motion::Motion;
 use spatter_core::Vec3;
@@ -322,17 +323,20 @@ pub(crate) fn sample_every(p: &ProbeConfig, dt: f64) -> u64 {
 }
 
 /// Records a sample after a step that ends on the sampling grid: the force the particles exert on the
-/// probe against its drive direction, from the step's last force evaluation.
+/// probe against its drive direction, from the step's last force evaluation. On several ranks the force
+/// is summed over the ranks in rank order (collective at the sampling steps), so every rank keeps the same
+/// samples.
 pub(crate) fn after_step<L: ContactLaw>(
     p: &ProbeConfig,
     sim: &Simulation<L>,
     s: &mut ProbeState,
     every: u64,
+    comm: &dyn Comm,
 ) {
     let t = sim.time();
     s.depth_now = s.depth(p.speed_m_s, t);
     if sim.step_count() % every == 0 {
-        let force = -sim.wall_force(s.wall).dot(s.dir);
+        let force = -sim.wall_force_with(comm, s.wall).dot(s.dir);
         s.samples.push((t, s.depth_now, force));
     }
 }

@@ -63,14 +63,13 @@ struct RankPart<S, P> {
 }
 
 /// What runs on one rank only: a run on several ranks (`mpirun`) with any of these is refused with one
-/// sentence naming the key.
+/// sentence naming the key. `external`: the run has forces from outside the engine that look beyond each
+/// particle's own state ([`spatter_dem::sim::ExternalForces::per_particle`]).
 fn refuse_on_ranks(cfg: &SceneConfig, external: bool, comm: &dyn Comm) -> Result<(), DemError> {
     if comm.size() == 1 {
         return Ok(());
     }
     let one_rank = [
-        ("bed", cfg.bed.is_some()),
-        ("probe", cfg.probe.is_some()),
         (
             "engine.integrator",
             !matches!(cfg.engine.integrator, Integrator::VelocityVerlet | Integrator::SymplecticEuler),
@@ -804,7 +803,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
 ) -> Result<(RunSummary, Option<SceneResults>), P::Error> {
     let comm = ctx.comm;
     let (root, ranks) = (comm.is_root(), comm.size() > 1);
-    refuse_on_ranks(cfg, built.external.is_some(), comm)?;
+    refuse_on_ranks(cfg, built.external.as_ref().is_some_and(|e| !e.per_particle()), comm)?;
     let mut sim = simulation(law, built, cfg);
     let mut injectors = setup::injectors(cfg, sim.templates())?;
     let total_steps = (cfg.duration_s / cfg.dt_s).round().max(1.0) as u64;
@@ -987,7 +986,7 @@ fn run_with<L: ContactLaw, P: StepPartner>(
         partner.before_step(&mut sim)?;
         sim.step_with(comm)?;
         if let (Some(p), Some(st)) = (&cfg.probe, probe.as_mut()) {
-            super::probe::after_step(p, &sim, st, probe_every);
+            super::probe::after_step(p, &sim, st, probe_every, comm);
         }
         let trajectories = out.files.as_mut().and_then(|f| f.trajectories.as_mut());
         record_step(cfg, &sim, &mut events, trajectories, comm)?;
@@ -1034,7 +1033,8 @@ fn run_with<L: ContactLaw, P: StepPartner>(
     sim.gather_mesh_records(comm);
     let mut s = summary(cfg, &sim, &totals, &injectors, &warnings, ctx);
     super::bed_outputs::finish(cfg, &sim, pour.as_ref(), ctx, &mut s)?;
-    if let (Some(p), Some(st)) = (&cfg.probe, &probe) {
+    // Every rank holds the same samples; rank 0 writes them.
+    if let (Some(p), Some(st), true) = (&cfg.probe, &probe, root) {
         super::probe::finish(p, st, ctx, &mut s)?;
     }
     summarize_records(cfg, &events, ctx, &mut s);

@@ -203,4 +203,10 @@ impl<S: FluidSampler> ExternalForces for FluidForces<S> {
         self.outside =
             add_fluid_forces(&self.sampler, &self.options, time, particles, &mut self.hints, force);
     }
+
+    /// The drag on a sphere is sampled at its own centre from its own velocity (the hints only speed up
+    /// the search of an imported mesh).
+    fn per_particle(&self) -> bool {
+        true
+    }
 }

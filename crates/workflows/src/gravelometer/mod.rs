@@ -44,8 +44,32 @@ pub enum GravelometerError {
 /// `docs/gravelometer.md`).
 pub fn run(cfg: &GravelometerConfig, ctx: &RunContext) -> Result<RunSummary, GravelometerError> {
     let plan = scene::plan(cfg)?;
+    let comm = ctx.comm;
+    if comm.size() > 1 && cfg.air() == AirMode::Coupled {
+        return Err(GravelometerError::Config {
+            key: "air".into(),
+            message: format!(
+                "\"coupled\" runs in one process in this version, and this run has {} ranks: use \"prescribed\" \
+                 or \"none\" on ranks, or start the coupled run without mpirun",
+                comm.size()
+            ),
+        });
+    }
     let geo = ctx.dir.path("geometry");
-    let strips = scene::write_geometry(&plan, &geo)?;
+    // On several ranks rank 0 writes the geometry and every rank reads it: all wait until it is written,
+    // and a rank 0 that failed to write ends every rank.
+    let strips = if comm.is_root() { scene::write_geometry(&plan, &geo) } else { Ok(scene::strips(&plan)) };
+    if comm.size() > 1 {
+        let mut failed = [u64::from(strips.is_err())];
+        comm.all_sum_u64(&mut failed);
+        if failed[0] > 0 && strips.is_ok() {
+            return Err(GravelometerError::Config {
+                key: "geometry".into(),
+                message: "rank 0 could not write the geometry files (its error ends the run)".into(),
+            });
+        }
+    }
+    let strips = strips?;
     let scfg = scene::scene(cfg, &plan, &geo);
     tracing::info!(
         "gravelometer {}: {} stone template(s), mean diameter {:.2} mm, launch velocity ({:.2}, {:.2}, {:.2}) m/s, \
@@ -97,8 +121,9 @@ pub fn run(cfg: &GravelometerConfig, ctx: &RunContext) -> Result<RunSummary, Gra
     } else {
         crate::dem_scene::run_collect_with(&scfg, ctx, hook)?
     };
+    // Rank 0 holds the whole records (mesh walls, events, bodies of every rank) and writes the results.
     let Some(r) = results else { return Ok(summary) };
-    if summary.finished != Finished::Completed {
+    if summary.finished != Finished::Completed || !comm.is_root() {
         return Ok(summary);
     }
     results::report(cfg, &plan, &strips, &r, ctx, &mut summary)?;

@@ -329,6 +329,11 @@ fn auto_dt(cfg: &GravelometerConfig, stones: &[Stone], speed: f64) -> f64 {
     dt
 }
 
+/// The strip (1 at the top) of each panel triangle, as [`write_geometry`] returns it, without writing.
+pub fn strips(plan: &Plan) -> Vec<usize> {
+    geometry::panel(&plan.dims).1
+}
+
 /// Writes the generated meshes to `dir` (STL) and returns the panel's strip of every triangle.
 pub fn write_geometry(plan: &Plan, dir: &Path) -> Result<Vec<usize>, GravelometerError> {
     std::fs::create_dir_all(dir).map_err(|source| GravelometerError::Io { path: dir.to_owned(), source })?;
