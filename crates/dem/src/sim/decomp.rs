@@ -451,12 +451,10 @@ impl<L: ContactLaw> Simulation<L> {
             let g = &d.ghosts;
             let p = &self.particles;
             let default = L::State::default();
-            if g.start.len() == p.len() + 1 {
-                for i in 0..p.len() {
-                    for k in g.start[i] as usize..g.start[i + 1] as usize {
-                        if g.state[k] != default {
-                            carry.push((pair_key(p.id[i], g.id[g.nbr[k] as usize]), g.state[k]));
-                        }
+            for i in 0..super::neighbors::listed(&g.start, p.len()) {
+                for k in g.start[i] as usize..g.start[i + 1] as usize {
+                    if g.state[k] != default {
+                        carry.push((pair_key(p.id[i], g.id[g.nbr[k] as usize]), g.state[k]));
                     }
                 }
             }

@@ -79,13 +79,11 @@ impl<L: ContactLaw> Simulation<L> {
         {
             let p = &self.particles;
             let l = &self.st.list;
-            if l.start.len() == p.len() + 1 {
-                for i in 0..p.len() {
-                    for k in l.start[i] as usize..l.start[i + 1] as usize {
-                        if l.state[k] != default {
-                            let (a, b) = (p.id[i], p.id[(l.nbr[k] & NBR_MASK) as usize]);
-                            carry.push((pair_key(a, b), l.state[k]));
-                        }
+            for i in 0..listed(&l.start, p.len()) {
+                for k in l.start[i] as usize..l.start[i + 1] as usize {
+                    if l.state[k] != default {
+                        let (a, b) = (p.id[i], p.id[(l.nbr[k] & NBR_MASK) as usize]);
+                        carry.push((pair_key(a, b), l.state[k]));
                     }
                 }
             }
@@ -95,13 +93,11 @@ impl<L: ContactLaw> Simulation<L> {
         {
             let p = &self.particles;
             let wl = &self.st.wall_list;
-            if wl.start.len() == p.len() + 1 {
-                let out = |k: usize| wl.out.get(k).copied().unwrap_or_default();
-                for i in 0..p.len() {
-                    for k in wl.start[i] as usize..wl.start[i + 1] as usize {
-                        if wl.state[k] != default || out(k).active {
-                            wall_carry.push(((p.id[i], wl.wall[k], wl.tri[k]), wl.state[k], out(k)));
-                        }
+            let out = |k: usize| wl.out.get(k).copied().unwrap_or_default();
+            for i in 0..listed(&wl.start, p.len()) {
+                for k in wl.start[i] as usize..wl.start[i + 1] as usize {
+                    if wl.state[k] != default || out(k).active {
+                        wall_carry.push(((p.id[i], wl.wall[k], wl.tri[k]), wl.state[k], out(k)));
                     }
                 }
             }
@@ -348,4 +344,16 @@ pub(super) type Carries<S> = (Vec<PairCarry<S>>, Vec<WallCarry<S>>);
 pub(super) fn pair_key(a: u32, b: u32) -> u64 {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
     ((lo as u64) << 32) | hi as u64
+}
+
+/// How many particles a neighbour list built at the last rebuild covers (`start` its offsets, `n` the
+/// particles now): the first `start.len() − 1`. Particles added since (injection, a pour) are appended
+/// after them without slots and keep the others' indices until the next rebuild sorts them, so the
+/// contact history of the listed ones is still where the list says. 0 for a list never built, or one
+/// that covers more particles than there are (none are removed between rebuilds).
+pub(super) fn listed(start: &[u32], n: usize) -> usize {
+    match start.len().checked_sub(1) {
+        Some(m) if m <= n => m,
+        _ => 0,
+    }
 }
