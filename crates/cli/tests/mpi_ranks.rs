@@ -73,7 +73,6 @@ fn several_ranks_are_refused_once_before_anything_is_written() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("two");
     let scenario = example("snow_single.toml");
-    let started = std::time::Instant::now();
     let o = mpirun(
         2,
         &["run", scenario.to_str().unwrap(), "--smoke", "--threads", "1", "--out", out.to_str().unwrap()],
@@ -83,7 +82,6 @@ fn several_ranks_are_refused_once_before_anything_is_written() {
     assert_eq!(err.matches("started on 2 ranks").count(), 1, "one sentence, from rank 0: {err}");
     assert!(err.contains("kind `snow_regime_map` runs in one process"), "{err}");
     assert!(!out.exists(), "nothing written");
-    assert!(started.elapsed() < Duration::from_secs(60));
     // Commands other than `run` are refused under several ranks as well.
     let v = mpirun(2, &["validate", "--quick"]);
     assert_eq!(v.status.code(), Some(2));
@@ -775,7 +773,6 @@ fn more_ranks_than_particles_is_refused_and_empty_ranks_run() {
         (&dem, 4, "error: ranks: splitting the particles over the ranks: 4 ranks for 3 particles"),
         (&sph, 3, "error: SPH set-up: splitting the fluid over the ranks: 3 ranks for 2 particles"),
     ] {
-        let started = std::time::Instant::now();
         let out = tmp.path().join(format!("out{ranks}"));
         let o = mpirun(
             ranks,
@@ -786,7 +783,11 @@ fn more_ranks_than_particles_is_refused_and_empty_ranks_run() {
         assert_eq!(err.matches(sentence).count(), 1, "one sentence, from rank 0: {err}");
         assert!(err.contains(&format!("use at most {} ranks", ranks - 1)), "{err}");
         assert!(!err.contains("panicked"), "{err}");
-        assert!(started.elapsed() < Duration::from_secs(60));
+        // Refused at the split, before the first step: no step's output in the run folder (a hang is
+        // caught by `mpirun`'s kill limit; no wall-clock limit here, timings belong to benchmarks).
+        for step_output in ["energy.csv", "series.csv", "particles.pvd", "summary.json"] {
+            assert!(!out.join(step_output).exists(), "{step_output} written before the refusal: {err}");
+        }
     }
     let column = dem_box(30, 0.02, [0.0, 0.0, 0.1], [0.1, 0.1, 0.5], 0.3);
     let mut counts = Vec::new();
