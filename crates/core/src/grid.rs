@@ -40,17 +40,32 @@ impl CellGrid {
         } else {
             Aabb::from_points(points)
         };
-        let bounds = if bounds.is_empty() { Aabb::new(Vec3::ZERO, Vec3::ZERO) } else { bounds };
+        // A non-finite corner (a point at infinity or NaN, which the engines report as a blow-up after
+        // the step) leaves one cell: every query still sees every point.
+        let finite = |v: Vec3| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
+        let bounds =
+            if bounds.is_empty() || !finite(bounds.min) || !finite(bounds.max) || !finite(bounds.extent()) {
+                Aabb::new(Vec3::ZERO, Vec3::ZERO)
+            } else {
+                bounds
+            };
         let max_cells = 4 * n + 4096;
         let mut size = cell_size;
         let dims = loop {
             let e = bounds.extent() / size;
-            let d = [e.x as usize + 1, e.y as usize + 1, e.z as usize + 1];
+            // Saturating: a stray point 1e300 m away must enlarge the cells, never overflow the count.
+            let cells = |x: f64| if x < 1e15 { x as usize + 1 } else { 1_000_000_000_000_000 };
+            let d = [cells(e.x), cells(e.y), cells(e.z)];
             let total = (d[0] as f64) * (d[1] as f64) * (d[2] as f64);
             if total <= max_cells as f64 {
                 break d;
             }
             size *= (total / max_cells as f64).cbrt() * 1.01;
+            if !size.is_finite() {
+                // Points near ±1.8e308 m apart: one cell holds them all.
+                size = f64::MAX;
+                break [1, 1, 1];
+            }
         };
         self.origin = bounds.min;
         self.cell_size = size;
@@ -214,6 +229,42 @@ mod tests {
         let mut n = 0;
         g.for_each_candidate(pts[100], |_| n += 1);
         assert!(n >= 1);
+    }
+
+    /// Points 1e300 m away or at infinity (a scene with a bed row at x = 1e300 m or a gravity of
+    /// 1e300 m/s² sent the engines here, where the cell count overflowed and the binning indexed out of
+    /// bounds): the grid stays within its cell budget and every query still finds its true neighbours.
+    #[test]
+    fn points_at_huge_or_infinite_distances_are_binned_and_found() {
+        let h = 0.07;
+        for far in
+            [Vec3::new(1e300, 0.0, 0.0), Vec3::new(-1e308, 1e308, 1e308), Vec3::new(f64::INFINITY, 0.0, 0.0)]
+        {
+            let mut pts = cloud(300, 5);
+            pts.push(far);
+            let mut g = CellGrid::new();
+            g.rebuild(&pts, h);
+            let d = g.dims();
+            assert!(
+                d.iter().all(|&k| k >= 1) && d[0] * d[1] * d[2] <= 4 * pts.len() + 4096,
+                "{far:?}: {d:?}"
+            );
+            let mut perm = g.entries().to_vec();
+            perm.sort_unstable();
+            assert_eq!(perm, (0..pts.len() as u32).collect::<Vec<_>>(), "{far:?}: entries is a permutation");
+            for p in pts.iter().take(300).step_by(23) {
+                let mut found = Vec::new();
+                g.for_each_candidate(*p, |j| {
+                    if (pts[j as usize] - *p).length() < h {
+                        found.push(j)
+                    }
+                });
+                found.sort_unstable();
+                let brute: Vec<u32> =
+                    (0..pts.len() as u32).filter(|&j| (pts[j as usize] - *p).length() < h).collect();
+                assert_eq!(found, brute, "{far:?}");
+            }
+        }
     }
 
     #[test]
