@@ -59,6 +59,14 @@ pub trait Comm: Send + Sync {
         true
     }
 
+    /// Wall time \[s\] this rank has spent inside the transport's collectives and exchanges since it
+    /// started, waiting for the other ranks included: with the time of a run, a measure of how long a rank
+    /// waited for slower ones (load imbalance) and for messages. 0 where the transport does not measure it
+    /// (one rank, thread-ranks).
+    fn seconds_in_collectives(&self) -> f64 {
+        0.0
+    }
+
     /// Element-wise sum over all ranks, added in rank order on every rank, so every rank holds the same
     /// bits whatever the transport does (an MPI sum may group terms differently on different ranks).
     fn sum_f64_ordered(&self, values: &mut [f64]) {

@@ -7,6 +7,8 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use mpi::Count;
 use spatter_core::comm::Comm;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 /// Message tags of the two rounds of a neighbour exchange (sizes, then payloads).
 const TAG_SIZES: i32 = 0x5A11;
@@ -20,6 +22,8 @@ pub struct MpiComm {
     size: usize,
     /// MPI granted calls from any thread, one at a time (`MPI_THREAD_SERIALIZED` or more).
     any_thread: bool,
+    /// Nanoseconds spent inside the collectives ([`Comm::seconds_in_collectives`]).
+    waited_ns: AtomicU64,
 }
 
 pub(crate) fn init(launcher_rank: usize) -> Result<Launch, LaunchError> {
@@ -34,7 +38,12 @@ pub(crate) fn init(launcher_rank: usize) -> Result<Launch, LaunchError> {
     };
     let world = universe.world();
     let any_thread = level >= mpi::Threading::Serialized;
-    let comm = MpiComm { rank: world.rank() as usize, size: world.size() as usize, any_thread };
+    let comm = MpiComm {
+        rank: world.rank() as usize,
+        size: world.size() as usize,
+        any_thread,
+        waited_ns: AtomicU64::new(0),
+    };
     // A panic on one rank must end the whole job, never leave the other ranks waiting in a collective.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -74,35 +83,19 @@ fn split(buf: &[u8], counts: &[Count], displs: &[Count]) -> Vec<Vec<u8>> {
     counts.iter().zip(displs).map(|(&c, &d)| buf[d as usize..(d + c) as usize].to_vec()).collect()
 }
 
-impl Comm for MpiComm {
-    fn rank(&self) -> usize {
-        self.rank
+/// The collectives themselves; the [`Comm`] methods time them.
+impl MpiComm {
+    /// Runs one collective and adds its wall time to [`Comm::seconds_in_collectives`] (two clock reads,
+    /// about 50 ns, against the call's microsecond).
+    fn timed<T>(&self, call: impl FnOnce() -> T) -> T {
+        let started = Instant::now();
+        let out = call();
+        let ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.waited_ns.fetch_add(ns, Ordering::Relaxed);
+        out
     }
-    fn size(&self) -> usize {
-        self.size
-    }
-    fn calls_from_any_thread(&self) -> bool {
-        self.any_thread
-    }
-    fn all_max_f64(&self, values: &mut [f64]) {
-        // MPI_MAX on doubles: exact in any order. A NaN is turned into +∞ first so that it wins on every
-        // rank (MPI leaves comparisons with NaN to the C library).
-        let local: Vec<f64> = values.iter().map(|&v| if v.is_nan() { f64::INFINITY } else { v }).collect();
-        let had_nan: Vec<u64> = values.iter().map(|v| u64::from(v.is_nan())).collect();
-        world().all_reduce_into(&local[..], values, SystemOperation::max());
-        let mut nan = had_nan;
-        self.all_sum_u64(&mut nan);
-        for (v, n) in values.iter_mut().zip(nan) {
-            if n > 0 {
-                *v = f64::NAN;
-            }
-        }
-    }
-    fn all_sum_u64(&self, values: &mut [u64]) {
-        let local = values.to_vec();
-        world().all_reduce_into(&local[..], values, SystemOperation::sum());
-    }
-    fn all_gather_bytes(&self, local: &[u8]) -> Vec<Vec<u8>> {
+
+    fn untimed_all_gather_bytes(&self, local: &[u8]) -> Vec<Vec<u8>> {
         let w = world();
         let mut counts = vec![0 as Count; self.size];
         w.all_gather_into(&count(local.len()), &mut counts[..]);
@@ -116,7 +109,7 @@ impl Comm for MpiComm {
         }
         split(&buf, &counts, &displs)
     }
-    fn neighbour_exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+    fn untimed_neighbour_exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
         assert_eq!(peers.len(), out.len(), "one buffer per peer");
         let w = world();
         let n = peers.len();
@@ -172,7 +165,7 @@ impl Comm for MpiComm {
         });
         got
     }
-    fn all_to_all_bytes(&self, out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+    fn untimed_all_to_all_bytes(&self, out: &[Vec<u8>]) -> Vec<Vec<u8>> {
         assert_eq!(out.len(), self.size, "one buffer per rank");
         let w = world();
         let send_counts: Vec<Count> = out.iter().map(|b| count(b.len())).collect();
@@ -189,7 +182,7 @@ impl Comm for MpiComm {
         }
         split(&buf, &recv_counts, &recv_displs)
     }
-    fn gather_bytes(&self, root: usize, local: &[u8]) -> Option<Vec<Vec<u8>>> {
+    fn untimed_gather_bytes(&self, root: usize, local: &[u8]) -> Option<Vec<Vec<u8>>> {
         let w = world();
         let root_process = w.process_at_rank(root as i32);
         let n = count(local.len());
@@ -208,7 +201,7 @@ impl Comm for MpiComm {
         }
         Some(split(&buf, &counts, &displs))
     }
-    fn broadcast_bytes(&self, root: usize, buf: &mut Vec<u8>) {
+    fn untimed_broadcast_bytes(&self, root: usize, buf: &mut Vec<u8>) {
         let w = world();
         let root_process = w.process_at_rank(root as i32);
         let mut len = buf.len() as u64;
@@ -220,8 +213,59 @@ impl Comm for MpiComm {
             root_process.broadcast_into(&mut buf[..]);
         }
     }
+}
+
+impl Comm for MpiComm {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.size
+    }
+    fn calls_from_any_thread(&self) -> bool {
+        self.any_thread
+    }
+    fn all_max_f64(&self, values: &mut [f64]) {
+        // MPI_MAX on doubles: exact in any order. A NaN is turned into +∞ first so that it wins on every
+        // rank (MPI leaves comparisons with NaN to the C library).
+        let local: Vec<f64> = values.iter().map(|&v| if v.is_nan() { f64::INFINITY } else { v }).collect();
+        let had_nan: Vec<u64> = values.iter().map(|v| u64::from(v.is_nan())).collect();
+        let mut nan = vec![0u64; values.len()];
+        self.timed(|| {
+            let w = world();
+            w.all_reduce_into(&local[..], values, SystemOperation::max());
+            w.all_reduce_into(&had_nan[..], &mut nan[..], SystemOperation::sum());
+        });
+        for (v, n) in values.iter_mut().zip(nan) {
+            if n > 0 {
+                *v = f64::NAN;
+            }
+        }
+    }
+    fn all_sum_u64(&self, values: &mut [u64]) {
+        let local = values.to_vec();
+        self.timed(|| world().all_reduce_into(&local[..], values, SystemOperation::sum()));
+    }
+    fn all_gather_bytes(&self, local: &[u8]) -> Vec<Vec<u8>> {
+        self.timed(|| self.untimed_all_gather_bytes(local))
+    }
+    fn neighbour_exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        self.timed(|| self.untimed_neighbour_exchange(peers, out))
+    }
+    fn all_to_all_bytes(&self, out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        self.timed(|| self.untimed_all_to_all_bytes(out))
+    }
+    fn gather_bytes(&self, root: usize, local: &[u8]) -> Option<Vec<Vec<u8>>> {
+        self.timed(|| self.untimed_gather_bytes(root, local))
+    }
+    fn broadcast_bytes(&self, root: usize, buf: &mut Vec<u8>) {
+        self.timed(|| self.untimed_broadcast_bytes(root, buf))
+    }
     fn barrier(&self) {
-        world().barrier();
+        self.timed(|| world().barrier());
+    }
+    fn seconds_in_collectives(&self) -> f64 {
+        self.waited_ns.load(Ordering::Relaxed) as f64 * 1e-9
     }
     fn abort(&self, code: i32) -> ! {
         world().abort(code)

@@ -258,9 +258,15 @@ fn run_on_ranks(
         }
         Err(e) => Err(e),
     };
+    // How long each rank waited in the collectives (read before the gathers below add to it).
+    let waited = comm.seconds_in_collectives();
     // Which ranks wrote a log of their own (every rank reaches this point: the outcomes above are
     // collective).
     let logged = comm.all_gather_bytes(&[u8::from(!root && spatter_io::runlog::written())]);
+    let waits = comm.all_gather_bytes(&waited.to_le_bytes());
+    if root && comm.size() > 1 {
+        tracing::info!("{}", collectives_line(&waits, started.elapsed().as_secs_f64()));
+    }
     if root {
         let files: Vec<String> = logged
             .iter()
@@ -283,6 +289,24 @@ fn run_on_ranks(
         spatter_io::runlog::open(&p, true)?;
     }
     result
+}
+
+/// The log line of the time every rank spent in the collectives (`waits`: each rank's seconds as
+/// little-endian bytes, in rank order) over `wall` seconds of this run's stretch: a rank that waits much
+/// longer than the others was waiting for slower ones (load imbalance) or for messages.
+fn collectives_line(waits: &[Vec<u8>], wall: f64) -> String {
+    let parts: Vec<String> = waits
+        .iter()
+        .enumerate()
+        .map(|(r, b)| {
+            let s = b.as_slice().try_into().map(f64::from_le_bytes).unwrap_or(f64::NAN);
+            format!("rank {r} {s:.3} s ({:.1} %)", 100.0 * s / wall.max(1e-300))
+        })
+        .collect();
+    format!(
+        "time in collectives and exchanges, waiting for the other ranks included, over {wall:.3} s: {}",
+        parts.join(", ")
+    )
 }
 
 /// The log of rank `rank` (> 0) of a run on several ranks, relative to the run folder.
@@ -520,6 +544,20 @@ impl RunControl for Timed<'_> {
 mod tests {
     use super::*;
     use spatter_core::control::Finished;
+
+    /// The collectives line gives every rank's seconds and their share of the run's wall time, in rank
+    /// order, and says so for a malformed entry instead of failing.
+    #[test]
+    fn the_collectives_line_lists_every_rank_with_its_share() {
+        let waits = vec![0.5f64.to_le_bytes().to_vec(), 1.25f64.to_le_bytes().to_vec(), vec![1, 2]];
+        let line = collectives_line(&waits, 5.0);
+        assert!(
+            line.ends_with(
+                "over 5.000 s: rank 0 0.500 s (10.0 %), rank 1 1.250 s (25.0 %), rank 2 NaN s (NaN %)"
+            ),
+            "{line}"
+        );
+    }
 
     /// The final check passes empty cells (values undefined by design) and names the file, line and
     /// column of a NaN or an infinity in any table of the run folder, and of a non-finite scalar.
