@@ -597,7 +597,10 @@ impl<L: ContactLaw> Simulation<L> {
     /// The blow-up error for an excessive overlap found in the last evaluation.
     pub(crate) fn blow_up_overlap(&self) -> DemError {
         let (a, b) = self.last_worst;
-        let ratio = self.st.last.max_overlap_ratio;
+        let r = self.st.last.max_overlap_ratio;
+        // Three decimals, or three significant digits in exponent form for a ratio beyond 10⁴ (a particle
+        // thrown 1e300 m into a wall printed a 300-digit number).
+        let ratio = if r.abs() < 1e4 { format!("{r:.3}") } else { format!("{r:.3e}") };
         let what = if b == u32::MAX {
             match self.deepest_wall(a) {
                 Some(name) => format!("overlap with wall `{name}` is {ratio:.3} of its radius"),

@@ -437,6 +437,29 @@ impl SphConfig {
     }
 }
 
+/// The camera of a wall's wetting picture: `view_dir` and `up` finite and non-zero, and not parallel
+/// when both are given (the picture could not be drawn; found here rather than after the run).
+fn check_view(c: &mut Checker, view_dir: Option<Vec3>, up: Option<Vec3>) {
+    let usable = |v: Vec3| spatter_core::math::is_finite(v) && v.length() > 0.0;
+    for (key, v) in [("view_dir", view_dir), ("up", up)] {
+        if let Some(v) = v.filter(|&v| !usable(v)) {
+            c.fail(key, format!("{key} = {:?} must be a finite, non-zero direction [x, y, z]", v.to_array()));
+        }
+    }
+    if let (Some(v), Some(u)) = (view_dir, up) {
+        if usable(v) && usable(u) && v.normalize().cross(u.normalize()).length() < 1e-6 {
+            c.fail(
+                "up",
+                format!(
+                    "up = {:?} is parallel to view_dir = {:?}; the picture needs an up direction across the view",
+                    u.to_array(),
+                    v.to_array()
+                ),
+            );
+        }
+    }
+}
+
 impl Validate for SphConfig {
     fn validate(&self, c: &mut Checker) {
         c.item("fluid", &self.fluid);
@@ -535,6 +558,7 @@ impl Validate for SphConfig {
                 if matches!(w.kind, WallType::Mesh | WallType::Cylinder) && self.fluid.dimensions == 2 {
                     c.fail("type", "mesh and cylinder walls need `dimensions = 3`");
                 }
+                check_view(c, w.view_dir, w.up);
             });
         }
         if self.fill.is_empty() {
