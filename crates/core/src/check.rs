@@ -159,7 +159,17 @@ impl Checker {
     /// `path` (relative to the scenario's folder unless absolute) must name an existing file.
     pub fn file_exists(&mut self, key: &str, path: &Path) {
         let full = self.resolve(path);
-        if !full.is_file() {
+        if full.is_dir() {
+            self.fail(
+                key,
+                format!(
+                    "{} = \"{}\" is a folder ({}); give the file inside it",
+                    Self::name(key),
+                    path.display(),
+                    full.display()
+                ),
+            );
+        } else if !full.is_file() {
             self.fail(
                 key,
                 format!("{} = \"{}\": no such file ({})", Self::name(key), path.display(), full.display()),
@@ -282,5 +292,19 @@ mod tests {
         assert_eq!(e[1].key, "walls[2].radius");
         assert_eq!(e[1].message, "radius = -3 must be a positive number");
         assert!(e[2].message.contains("no such file"), "{}", e[2].message);
+        // A folder where a file belongs says so (it used to read "no such file" for a path that exists).
+        let dir = std::env::temp_dir();
+        let mut c = Checker::new(None);
+        c.file_exists("bed.file", &dir);
+        c.mesh_file("walls[0].shape.file", &dir);
+        let e = c.finish().unwrap_err();
+        assert_eq!(e.len(), 2);
+        for e in &e {
+            assert!(
+                e.message.contains("is a folder") && !e.message.contains("no such file"),
+                "{}",
+                e.message
+            );
+        }
     }
 }
