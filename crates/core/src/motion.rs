@@ -107,13 +107,17 @@ impl MotionTable {
                 line: i + 1,
                 message: format!("`{line}` is not seven numbers `t vx vy vz wx wy wz`"),
             })?;
-            if vals.len() != 7 || vals.iter().any(|v| !v.is_finite()) {
+            if vals.len() != 7 {
                 return Err(MotionError::Line {
                     line: i + 1,
-                    message: format!(
-                        "expected seven finite numbers `t vx vy vz wx wy wz`, found {}",
-                        vals.len()
-                    ),
+                    message: format!("expected seven numbers `t vx vy vz wx wy wz`, found {}", vals.len()),
+                });
+            }
+            if let Some(k) = vals.iter().position(|v| !v.is_finite()) {
+                let name = ["t", "vx", "vy", "vz", "wx", "wy", "wz"][k];
+                return Err(MotionError::Line {
+                    line: i + 1,
+                    message: format!("{name} = {} is not a finite number", vals[k]),
                 });
             }
             rows.push((i + 1, vals));
@@ -410,8 +414,14 @@ mod tests {
         let e = MotionTable::parse("0 0 0 0 0 0 0\n0 1 0 0 0 0 0\n", Vec3::ZERO).unwrap_err();
         assert!(e.to_string().contains("line 2") && e.to_string().contains("does not increase"), "{e}");
         let e = MotionTable::parse("0 0 0\n", Vec3::ZERO).unwrap_err();
-        assert!(e.to_string().contains("line 1"), "{e}");
+        assert!(e.to_string().contains("line 1") && e.to_string().contains("found 3"), "{e}");
         assert!(MotionTable::parse("\n# nothing\n", Vec3::ZERO).is_err());
+        // A value that overflowed (a speed of 1e308 scaled up) names its column, not the count.
+        let e = MotionTable::parse("0 1 0 0 0 0 0\n1 inf 0 0 0 0 0\n", Vec3::ZERO).unwrap_err();
+        assert!(
+            e.to_string().contains("line 2") && e.to_string().contains("vx = inf is not a finite number"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -765,6 +765,37 @@ impl SceneConfig {
     }
 }
 
+/// The memory of a lattice fill, from the lattice points of its region's volume (√2/s³ per m³, the
+/// densest lattice, fcc, at nearest-neighbour distance s): a spacing of a nanometre in a box of
+/// centimetres asks for more particles than any machine holds, and would only fail once the lattice was
+/// being built. Mesh regions are not estimated (their volume needs the file).
+fn lattice_memory(c: &mut Checker, f: &FillConfig) {
+    let spacing = f
+        .spacing_m
+        .or_else(|| f.size.as_ref().and_then(spatter_dem::insertion::max_diameter).map(|d| 1.01 * d));
+    let volume = match &f.region {
+        RegionConfig::Box { min_m, max_m } => {
+            let e = *max_m - *min_m;
+            (e.x * e.y * e.z).abs()
+        }
+        RegionConfig::Cylinder { radius_m, height_m, .. } => {
+            std::f64::consts::PI * radius_m * radius_m * height_m.abs()
+        }
+        RegionConfig::Mesh { .. } => return,
+    };
+    if let Some(s) = spacing.filter(|&s| s > 0.0 && s.is_finite()) {
+        let points = volume * std::f64::consts::SQRT_2 / (s * s * s);
+        if points.is_finite() {
+            let key = if f.spacing_m.is_some() { "spacing_m" } else { "size" };
+            c.memory_estimate(
+                key,
+                &format!("about {points:.3e} lattice points at spacing {s} m × {BYTES_PER_PARTICLE} B"),
+                points * BYTES_PER_PARTICLE as f64,
+            );
+        }
+    }
+}
+
 impl Validate for SceneConfig {
     fn validate(&self, c: &mut Checker) {
         c.positive("dt_s", self.dt_s);
@@ -798,6 +829,9 @@ impl Validate for SceneConfig {
                         n as f64 * BYTES_PER_PARTICLE as f64,
                     )
                 });
+            }
+            if f.method == FillMethod::Lattice {
+                c.element("fill", i, |c| lattice_memory(c, f));
             }
         }
         c.finite_vec("gravity_m_s2", self.gravity_m_s2);

@@ -13,18 +13,41 @@ use std::path::{Path, PathBuf};
 
 /// `file` must exist and `parse` must accept its text, so a garbled table fails at `spatter check`; the
 /// parser's message names the file, line, value and expected form.
-fn parsed_file<T>(c: &mut Checker, key: &str, file: &Path, parse: impl Fn(&str, &Path) -> Result<T, String>) {
+fn parsed_file<T>(
+    c: &mut Checker,
+    key: &str,
+    file: &Path,
+    parse: impl Fn(&str, &Path) -> Result<T, String>,
+) -> Option<T> {
     let full = c.resolve(file);
     if !full.is_file() {
-        return c.file_exists(key, file);
+        c.file_exists(key, file);
+        return None;
     }
     match std::fs::read_to_string(&full) {
-        Err(e) => c.fail(key, format!("{}: {e}", file.display())),
-        Ok(text) => {
-            if let Err(e) = parse(&text, &full) {
-                c.fail(key, e);
-            }
+        Err(e) => {
+            c.fail(key, format!("{}: {e}", file.display()));
+            None
         }
+        Ok(text) => parse(&text, &full).map_err(|e| c.fail(key, e)).ok(),
+    }
+}
+
+/// Fastest vehicle speed a wading run accepts \[m/s\] (360 km/h). The water's sound speed, and with it
+/// the number of time steps, grows with the vehicle speed: a mistyped 1e6 m/s would ask for billions of
+/// steps (and a path thousands of kilometres long) instead of an error.
+pub const MAX_SPEED_M_S: f64 = 100.0;
+
+/// Refuses a vehicle speed above [`MAX_SPEED_M_S`] under `key`, `what` saying where it comes from.
+fn check_speed(c: &mut Checker, key: &str, what: &str, v: f64) {
+    if v > MAX_SPEED_M_S {
+        c.fail(
+            key,
+            format!(
+                "{what} {v} m/s is faster than {MAX_SPEED_M_S} m/s; wading speeds are a few m/s (the time step \
+                 shrinks as the speed grows)"
+            ),
+        );
     }
 }
 
@@ -293,6 +316,36 @@ impl Default for WadingOutput {
     }
 }
 
+impl WadingConfig {
+    /// Refuses a spacing whose particles could not fit in memory, from a lower bound: the water of the
+    /// pool (pool length × width × water depth / dp³) and the road's wall particles (the channel's length
+    /// × width / dp², four layers), without the vehicle's surfaces and the ramps' water. A channel from a
+    /// file is not estimated here.
+    fn check_memory(&self, c: &mut Checker) {
+        let dp = self.fluid.spacing_m;
+        let Some(ch) = self.channel.generated() else { return };
+        if !(dp > 0.0 && dp.is_finite()) {
+            return;
+        }
+        let length = ch.approach_length_m + 2.0 * ch.ramp_length_m + ch.pool_length_m + ch.exit_length_m;
+        let water = ch.pool_length_m * ch.width_m * ch.water_depth_m / (dp * dp * dp);
+        let road = 4.0 * length * ch.width_m / (dp * dp);
+        let n = water + road;
+        if n.is_finite() {
+            c.nested("fluid", |c| {
+                c.memory_estimate(
+                    "spacing_m",
+                    &format!(
+                        "spacing_m = {dp} m gives at least {n:.3e} particles (the pool's water and the road); × {} B, that",
+                        crate::sph_scene::config::BYTES_PER_PARTICLE
+                    ),
+                    n * crate::sph_scene::config::BYTES_PER_PARTICLE,
+                )
+            });
+        }
+    }
+}
+
 impl Validate for WadingConfig {
     fn validate(&self, c: &mut Checker) {
         c.item("fluid", &self.fluid);
@@ -310,6 +363,7 @@ impl Validate for WadingConfig {
             c.finite_vec("air_velocity_m_s", self.drag.air_velocity_m_s);
         });
         c.item("channel", &self.channel);
+        self.check_memory(c);
         self.check_vehicle_width(c);
         c.nested("vehicle", |c| {
             if self.vehicle.parts.is_empty() {
@@ -332,15 +386,26 @@ impl Validate for WadingConfig {
         });
         c.nested("motion", |c| {
             match (self.motion.speed_m_s, &self.motion.file, &self.motion.path) {
-            (Some(v), None, None) => c.positive("speed_m_s", v),
-            (None, Some(f), None) => parsed_file(c, "file", f, SpeedProfile::parse),
+            (Some(v), None, None) => {
+                c.positive("speed_m_s", v);
+                check_speed(c, "speed_m_s", "speed_m_s =", v);
+            }
+            (None, Some(f), None) => {
+                if let Some(t) = parsed_file(c, "file", f, SpeedProfile::parse) {
+                    check_speed(c, "file", &format!("{}: the fastest speed,", f.display()), t.max_speed());
+                }
+            }
             (None, None, Some(p)) => c.nested("path", |c| match (&p.file, &p.rows) {
-                (Some(f), None) => parsed_file(c, "file", f, VehiclePath::parse),
-                (None, Some(rows)) => {
-                    if let Err(e) = VehiclePath::from_rows(rows) {
-                        c.fail("rows", e);
+                (Some(f), None) => {
+                    if let Some(path) = parsed_file(c, "file", f, VehiclePath::parse) {
+                        let what = format!("{}: the fastest speed along the path,", f.display());
+                        check_speed(c, "file", &what, path.max_speed());
                     }
                 }
+                (None, Some(rows)) => match VehiclePath::from_rows(rows) {
+                    Err(e) => c.fail("rows", e),
+                    Ok(path) => check_speed(c, "rows", "the fastest speed along the path,", path.max_speed()),
+                },
                 _ => c.fail(
                     "file",
                     "give exactly one of file (rows `t_s x_m y_m [z_m]`) and rows ([[t, x, y], …] inline)",
