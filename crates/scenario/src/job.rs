@@ -179,6 +179,28 @@ fn shared<T>(
     }
 }
 
+/// Makes a scenario's outcome the same on every rank (collective). Its errors are meant to be collective
+/// already (every rank returns the same one); an error only some ranks meet (a picture that rank 0 alone
+/// draws, a file only it writes) would leave the others in the job's next collective for ever. Every rank
+/// learns whether another failed, and a rank that succeeded returns the lowest failing rank's message.
+fn agree_on_failure(comm: &dyn Comm, mine: Result<RunSummary, JobError>) -> Result<RunSummary, JobError> {
+    if comm.size() == 1 {
+        return mine;
+    }
+    let text = match &mine {
+        Err(e) => [&[1u8][..], e.to_string().as_bytes()].concat(),
+        Ok(_) => vec![0u8],
+    };
+    let all = comm.all_gather_bytes(&text);
+    match (mine, all.iter().enumerate().find(|(_, b)| b.first() == Some(&1))) {
+        (Ok(_), Some((rank, b))) => {
+            let message = format!("rank {rank}: {}", String::from_utf8_lossy(&b[1..]));
+            Err(JobError::Run(message.into()))
+        }
+        (mine, _) => mine,
+    }
+}
+
 /// A run on several ranks (see [`run_with_comm`]).
 fn run_on_ranks(
     loaded: &Loaded,
@@ -234,7 +256,7 @@ fn run_on_ranks(
     let started = Instant::now();
     // The scenario's errors are collective (every rank returns the same one); a failed write on one rank
     // ends the whole run there.
-    let result = loaded.scenario.run(&ctx).map_err(JobError::Run);
+    let result = agree_on_failure(comm, loaded.scenario.run(&ctx).map_err(JobError::Run));
     let wall = earlier_wall_s + started.elapsed().as_secs_f64();
     let result = match result {
         Ok(summary) => {
@@ -602,5 +624,34 @@ mod tests {
             errors[0]
         );
         assert!(!out.exists());
+    }
+
+    /// An error that only one rank meets becomes every rank's (naming the rank), so that no rank goes on
+    /// to wait in a collective the failed one never joins; outcomes that agree pass unchanged.
+    #[test]
+    fn a_failure_on_one_rank_is_every_ranks_failure() {
+        use spatter_core::comm::ThreadComm;
+        for failing in [0, 1] {
+            let out = ThreadComm::run(3, |c| {
+                let mine = if c.rank() == failing {
+                    Err(JobError::Run("cannot draw wetting/wall.png".into()))
+                } else {
+                    Ok(RunSummary::new(Finished::Completed))
+                };
+                agree_on_failure(c, mine).map(|_| ()).map_err(|e| e.to_string())
+            });
+            for (r, o) in out.iter().enumerate() {
+                let e = o.as_ref().unwrap_err();
+                let expected = if r == failing {
+                    "cannot draw wetting/wall.png".to_string()
+                } else {
+                    format!("rank {failing}: cannot draw wetting/wall.png")
+                };
+                assert_eq!(e, &expected, "rank {r} of a run failing on rank {failing}");
+            }
+        }
+        let ok =
+            ThreadComm::run(2, |c| agree_on_failure(c, Ok(RunSummary::new(Finished::Completed))).is_ok());
+        assert_eq!(ok, vec![true, true]);
     }
 }
