@@ -10,6 +10,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Largest coordinate magnitude a mesh file may hold, in its own units (a billion kilometres in metres).
+pub const MAX_COORDINATE: f64 = 1e12;
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from the side their normal points to.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct TriMesh {
@@ -112,6 +114,20 @@ impl TriMesh {
             return Err(MeshError::Invalid {
                 path: path.to_owned(),
                 message: format!("vertex {i} has a non-finite coordinate"),
+            });
+        }
+        // Areas are products of coordinates: beyond about 1e150 they overflow and every triangle would read
+        // as degenerate. No geometry of this code reaches a billion kilometres in any unit.
+        let far = |v: &Vec3| v.x.abs().max(v.y.abs()).max(v.z.abs()) > MAX_COORDINATE;
+        if let Some(i) = mesh.vertices.iter().position(far) {
+            let v = mesh.vertices[i];
+            return Err(MeshError::Invalid {
+                path: path.to_owned(),
+                message: format!(
+                    "vertex {i} at [{:e}, {:e}, {:e}] lies beyond ±{MAX_COORDINATE:e} (in the file's units); check the \
+                     file's coordinates and units",
+                    v.x, v.y, v.z
+                ),
             });
         }
         if let Some(message) = mesh.zero_area_report() {
@@ -513,6 +529,34 @@ mod tests {
         let e = TriMesh::load(&bad, 1.0).unwrap_err().to_string();
         assert!(e.contains("bad.stl") && e.contains("1 of its 9 triangles have zero area"), "{e}");
         assert!(e.contains("triangle 8"), "{e}");
+    }
+
+    /// A vertex at 1e300 (a corrupted or mistyped file) is refused for its coordinate, not reported as a
+    /// mesh of zero-area triangles (its areas overflowed).
+    #[test]
+    fn huge_coordinates_are_refused_for_what_they_are() {
+        let dir = tempfile::tempdir().unwrap();
+        // ASCII STL holds doubles (binary STL's single precision would read 1e300 as infinity).
+        let path = dir.path().join("far.stl");
+        let facet = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+            format!(
+                "facet normal 0 0 1\nouter loop\nvertex {} {} {}\nvertex {} {} {}\nvertex {} {} {}\nendloop\nendfacet\n",
+                a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]
+            )
+        };
+        let text = format!(
+            "solid far\n{}{}endsolid far\n",
+            facet([0.0, 0.0, 0.0], [1e300, 0.0, 0.0], [0.0, 1.0, 0.0]),
+            facet([0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0])
+        );
+        std::fs::write(&path, text).unwrap();
+        let e = TriMesh::load(&path, 1.0).unwrap_err().to_string();
+        assert!(e.contains("far.stl") && e.contains("beyond ±1e12") && !e.contains("zero area"), "{e}");
+        // A mesh in millimetres a kilometre across is fine.
+        let big = TriMesh::rectangle(1e6, 1e6, 0.0, 2, 2);
+        let path = dir.path().join("big.stl");
+        std::fs::write(&path, big.to_binary_stl()).unwrap();
+        assert!(TriMesh::load(&path, 1e-3).is_ok());
     }
 
     #[test]
