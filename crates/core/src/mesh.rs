@@ -110,7 +110,18 @@ impl TriMesh {
         if mesh.triangles.is_empty() {
             return Err(MeshError::Invalid { path: path.to_owned(), message: "holds no triangles".into() });
         }
-        if let Some(i) = mesh.vertices.iter().position(|v| !crate::math::is_finite(*v)) {
+        mesh.validate(path)?;
+        if scale != 1.0 {
+            mesh.vertices.iter_mut().for_each(|v| *v *= scale);
+        }
+        Ok(mesh)
+    }
+
+    /// The checks [`Self::load`] makes on a mesh read from `path` (named in the error): every coordinate
+    /// finite and within ±[`MAX_COORDINATE`], no zero-area triangle. For meshes read otherwise (the solids
+    /// of a multi-solid STL).
+    pub fn validate(&self, path: &Path) -> Result<(), MeshError> {
+        if let Some(i) = self.vertices.iter().position(|v| !crate::math::is_finite(*v)) {
             return Err(MeshError::Invalid {
                 path: path.to_owned(),
                 message: format!("vertex {i} has a non-finite coordinate"),
@@ -119,8 +130,8 @@ impl TriMesh {
         // Areas are products of coordinates: beyond about 1e150 they overflow and every triangle would read
         // as degenerate. No geometry of this code reaches a billion kilometres in any unit.
         let far = |v: &Vec3| v.x.abs().max(v.y.abs()).max(v.z.abs()) > MAX_COORDINATE;
-        if let Some(i) = mesh.vertices.iter().position(far) {
-            let v = mesh.vertices[i];
+        if let Some(i) = self.vertices.iter().position(far) {
+            let v = self.vertices[i];
             return Err(MeshError::Invalid {
                 path: path.to_owned(),
                 message: format!(
@@ -130,13 +141,10 @@ impl TriMesh {
                 ),
             });
         }
-        if let Some(message) = mesh.zero_area_report() {
+        if let Some(message) = self.zero_area_report() {
             return Err(MeshError::Invalid { path: path.to_owned(), message });
         }
-        if scale != 1.0 {
-            mesh.vertices.iter_mut().for_each(|v| *v *= scale);
-        }
-        Ok(mesh)
+        Ok(())
     }
 
     /// Names the first zero-area triangle (corners on one line, area below 1e-12 of the squared bounding

@@ -374,7 +374,15 @@ impl Validate for WadingConfig {
             }
             for (i, p) in self.vehicle.parts.iter().enumerate() {
                 c.element("parts", i, |c| {
-                    c.file_exists("file", &p.file);
+                    let full = c.resolve(&p.file);
+                    if full.is_file() {
+                        // The same reading as the run's, so a broken part is found by `spatter check`.
+                        if let Err(e) = super::parts::read_parts(&full, 1.0) {
+                            c.fail("file", e.to_string());
+                        }
+                    } else {
+                        c.file_exists("file", &p.file);
+                    }
                     c.positive("scale", p.scale);
                 });
             }

@@ -90,6 +90,14 @@ pub fn read_parts(path: &Path, scale: f64) -> Result<Vec<NamedPart>, MeshError> 
                 message: format!("{label} (line {}) holds no triangles", first + 1),
             });
         }
+        // The checks of a mesh read whole (non-finite or far coordinates, zero-area triangles), naming the
+        // solid.
+        mesh.validate(path).map_err(|e| match e {
+            MeshError::Invalid { path, message } => {
+                MeshError::Invalid { path, message: format!("{label} (line {}): {message}", first + 1) }
+            }
+            other => other,
+        })?;
         if scale != 1.0 {
             mesh.vertices.iter_mut().for_each(|v| *v *= scale);
         }
