@@ -457,8 +457,9 @@ impl Validate for WadingConfig {
 }
 
 impl WadingConfig {
-    /// A vehicle as wide as the channel or wider, when the part files and the channel read (their own
-    /// problems are reported by their keys).
+    /// The vehicle against what its part files hold, when they read (their own problems are reported by
+    /// their keys): wheels (part, axle direction, radius against the mesh), sensor names, and a vehicle
+    /// as wide as the channel or wider.
     fn check_vehicle_width(&self, c: &mut Checker) {
         let mut parts = Vec::new();
         for p in &self.vehicle.parts {
@@ -466,6 +467,12 @@ impl WadingConfig {
                 Ok(mut read) => parts.append(&mut read),
                 Err(_) => return,
             }
+        }
+        // The wheels and sensors against the parts, as the run checks them.
+        let mut errs = super::vehicle::check_wheels(&parts, &self.vehicle.wheels);
+        errs.extend(super::vehicle::check_sensor_names(&parts, &self.sensors));
+        for e in errs {
+            c.fail(&e.key, e.message);
         }
         let mut channel = self.channel.clone();
         if let Some(f) = &channel.file {

@@ -90,30 +90,10 @@ pub fn plan(cfg: &WadingConfig) -> Result<Plan, WadingError> {
             .map_err(|e| input(&format!("sensor_boxes[{i}].{}", e.key), e.message))?;
         groups.push(groups[k].clone());
     }
-    let errs = check_wheels(&parts, &cfg.vehicle.wheels);
+    let mut errs = check_wheels(&parts, &cfg.vehicle.wheels);
+    errs.extend(super::vehicle::check_sensor_names(&parts, &cfg.sensors));
     if let Some(e) = errs.into_iter().next() {
         return Err(input(&e.key, e.message));
-    }
-    for (k, w) in cfg.vehicle.wheels.iter().enumerate() {
-        let a = w.axis.normalize_or_zero();
-        if a.y.abs() < 0.999 {
-            return Err(input(
-                &format!("vehicle.wheels[{k}].axis"),
-                format!(
-                    "axis = [{}, {}, {}]: wheels roll about the y axis (across the channel)",
-                    w.axis.x, w.axis.y, w.axis.z
-                ),
-            ));
-        }
-    }
-    for (k, s) in cfg.sensors.iter().enumerate() {
-        if !parts.iter().any(|p| p.name == *s) {
-            let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
-            return Err(input(
-                &format!("sensors[{k}]"),
-                format!("\"{s}\" names no vehicle part; the parts are: {}", names.join(", ")),
-            ));
-        }
     }
     if let Some(e) = channel.check_vehicle_width(&parts) {
         return Err(input(&e.key, e.message));

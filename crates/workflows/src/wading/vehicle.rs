@@ -49,8 +49,9 @@ pub struct WheelSpec {
 pub const RADIUS_TOLERANCE: f64 = 0.02;
 
 /// Every problem of the wheels against the parts read: a wheel whose part does not exist (the message
-/// lists the parts), and a wheel whose mesh does not reach its declared radius from its axle (it would
-/// not touch the road, or would sink into it), each under the key `vehicle.wheels[k]…`.
+/// lists the parts), an axle not across the channel (y), and a wheel whose mesh does not reach its
+/// declared radius from its axle (it would not touch the road, or would sink into it), each under the key
+/// `vehicle.wheels[k]…`.
 pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
     let mut errs = Vec::new();
     let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
@@ -63,6 +64,16 @@ pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
             });
             continue;
         };
+        if let Some(j) = wheels[..k].iter().position(|o| o.part == w.part) {
+            errs.push(Invalid {
+                key: key("part"),
+                message: format!(
+                    "part = \"{}\" is already wheel {j} (vehicle.wheels[{j}]); each wheel is its own part",
+                    w.part
+                ),
+            });
+            continue;
+        }
         if !(w.radius_m > 0.0 && w.radius_m.is_finite()) {
             errs.push(Invalid {
                 key: key("radius_m"),
@@ -73,6 +84,17 @@ pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
         let axis = w.axis.normalize_or_zero();
         if axis == Vec3::ZERO {
             errs.push(Invalid { key: key("axis"), message: "axis = [0, 0, 0] has no direction".into() });
+            continue;
+        }
+        if axis.y.abs() < 0.999 {
+            // Before the reach: measured about another axis the mesh's reach says nothing about the radius.
+            errs.push(Invalid {
+                key: key("axis"),
+                message: format!(
+                    "axis = [{}, {}, {}]: wheels roll about the y axis (across the channel)",
+                    w.axis.x, w.axis.y, w.axis.z
+                ),
+            });
             continue;
         }
         let reach = wheel_reach(&part.mesh, w.axle_m, axis);
@@ -95,6 +117,20 @@ pub fn check_wheels(parts: &[NamedPart], wheels: &[WheelSpec]) -> Vec<Invalid> {
         }
     }
     errs
+}
+
+/// Every sensor name (`sensors[k]`) that names no part read, the message listing the parts.
+pub fn check_sensor_names(parts: &[NamedPart], sensors: &[String]) -> Vec<Invalid> {
+    let names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+    sensors
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| !names.contains(&s.as_str()))
+        .map(|(k, s)| Invalid {
+            key: format!("sensors[{k}]"),
+            message: format!("\"{s}\" names no vehicle part; the parts are: {}", names.join(", ")),
+        })
+        .collect()
 }
 
 /// A vehicle as wide as the channel or wider: `width` \[m\] across the channel, reported under `key`
