@@ -195,16 +195,13 @@ mod tests {
         (0..n).map(|_| Vec3::new(r(), 0.5 * r(), 2.0 * r())).collect()
     }
 
-    #[test]
-    fn finds_exactly_the_brute_force_neighbours() {
-        let pts = cloud(2000, 7);
-        let h = 0.07;
-        let mut g = CellGrid::new();
-        g.rebuild(&pts, h);
+    /// The grid's entries are a permutation of the points, and the candidates of every `step`-th of the
+    /// first `queries` points within `h` are exactly the points a brute-force search finds.
+    fn assert_brute_force_neighbours(g: &CellGrid, pts: &[Vec3], h: f64, queries: usize, step: usize) {
         let mut perm = g.entries().to_vec();
         perm.sort_unstable();
         assert_eq!(perm, (0..pts.len() as u32).collect::<Vec<_>>(), "entries is a permutation");
-        for (i, p) in pts.iter().enumerate().step_by(37) {
+        for (i, p) in pts.iter().enumerate().take(queries).step_by(step) {
             let mut found = Vec::new();
             g.for_each_candidate(*p, |j| {
                 if (pts[j as usize] - *p).length() < h {
@@ -216,6 +213,15 @@ mod tests {
                 (0..pts.len() as u32).filter(|&j| (pts[j as usize] - *p).length() < h).collect();
             assert_eq!(found, brute, "point {i}");
         }
+    }
+
+    #[test]
+    fn finds_exactly_the_brute_force_neighbours() {
+        let pts = cloud(2000, 7);
+        let h = 0.07;
+        let mut g = CellGrid::new();
+        g.rebuild(&pts, h);
+        assert_brute_force_neighbours(&g, &pts, h, pts.len(), 37);
     }
 
     #[test]
@@ -249,21 +255,7 @@ mod tests {
                 d.iter().all(|&k| k >= 1) && d[0] * d[1] * d[2] <= 4 * pts.len() + 4096,
                 "{far:?}: {d:?}"
             );
-            let mut perm = g.entries().to_vec();
-            perm.sort_unstable();
-            assert_eq!(perm, (0..pts.len() as u32).collect::<Vec<_>>(), "{far:?}: entries is a permutation");
-            for p in pts.iter().take(300).step_by(23) {
-                let mut found = Vec::new();
-                g.for_each_candidate(*p, |j| {
-                    if (pts[j as usize] - *p).length() < h {
-                        found.push(j)
-                    }
-                });
-                found.sort_unstable();
-                let brute: Vec<u32> =
-                    (0..pts.len() as u32).filter(|&j| (pts[j as usize] - *p).length() < h).collect();
-                assert_eq!(found, brute, "{far:?}");
-            }
+            assert_brute_force_neighbours(&g, &pts, h, 300, 23);
         }
     }
 

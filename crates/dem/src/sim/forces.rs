@@ -603,11 +603,11 @@ impl<L: ContactLaw> Simulation<L> {
         let ratio = if r.abs() < 1e4 { format!("{r:.3}") } else { format!("{r:.3e}") };
         let what = if b == u32::MAX {
             match self.deepest_wall(a) {
-                Some(name) => format!("overlap with wall `{name}` is {ratio:.3} of its radius"),
-                None => format!("overlap with a wall is {ratio:.3} of its radius"),
+                Some(name) => format!("overlap with wall `{name}` is {ratio} of its radius"),
+                None => format!("overlap with a wall is {ratio} of its radius"),
             }
         } else {
-            format!("overlap with particle id {b} is {ratio:.3} of the smaller radius")
+            format!("overlap with particle id {b} is {ratio} of the smaller radius")
         };
         DemError::BlowUp {
             particle: a,

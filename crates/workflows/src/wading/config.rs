@@ -468,24 +468,26 @@ impl WadingConfig {
                 Err(_) => return,
             }
         }
-        // The wheels and sensors against the parts, as the run checks them.
-        let mut errs = super::vehicle::check_wheels(&parts, &self.vehicle.wheels);
-        errs.extend(super::vehicle::check_sensor_names(&parts, &self.sensors));
-        for e in errs {
-            c.fail(&e.key, e.message);
-        }
         let mut channel = self.channel.clone();
         if let Some(f) = &channel.file {
             channel.file = Some(c.resolve(f));
         }
         let has_water = self.channel.water_depth_m > 0.0;
-        if parts.is_empty() || !has_water {
+        if !parts.is_empty() && has_water {
+            if let Ok(ch) = super::layout::Channel::new(&channel) {
+                if let Some(e) = ch.check_vehicle_width(&parts) {
+                    c.fail(&e.key, e.message);
+                }
+            }
+        }
+        // Then the wheels and sensors against the parts, as the run checks them.
+        if parts.is_empty() {
             return;
         }
-        if let Ok(ch) = super::layout::Channel::new(&channel) {
-            if let Some(e) = ch.check_vehicle_width(&parts) {
-                c.fail(&e.key, e.message);
-            }
+        let mut errs = super::vehicle::check_wheels(&parts, &self.vehicle.wheels);
+        errs.extend(super::vehicle::check_sensor_names(&parts, &self.sensors));
+        for e in errs {
+            c.fail(&e.key, e.message);
         }
     }
 }
